@@ -1,0 +1,54 @@
+"""frontier_marl: learned frontier selection for autonomous grid exploration.
+
+Entry points::
+
+    import frontier_marl
+    par = frontier_marl.parallel_env(preset="thesis-20x20", n_agents=2)   # PettingZoo Parallel
+    aec = frontier_marl.env(preset="thesis-20x20")                        # PettingZoo AEC
+    import gymnasium as gym
+    single = gym.make("frontier_marl/FrontierExplore-v0", preset="thesis-20x20")
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
+from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
+from frontier_marl.registration import GYM_ID, PETTINGZOO_ID, register_envs
+
+__version__ = "0.1.0"
+
+
+def parallel_env(**kwargs: Any) -> FrontierParallelEnv:
+    """The PettingZoo ParallelEnv (see :class:`FrontierParallelEnv` for the arguments)."""
+    return FrontierParallelEnv(**kwargs)
+
+
+def raw_env(**kwargs: Any) -> Any:
+    """The AEC form of :func:`parallel_env`, without extra wrappers."""
+    from pettingzoo.utils.conversions import parallel_to_aec
+
+    return parallel_to_aec(parallel_env(**kwargs))
+
+
+def env(**kwargs: Any) -> Any:
+    """The PettingZoo AEC env (order-enforced), converted from :func:`parallel_env`."""
+    return raw_env(**kwargs)
+
+
+register_envs()
+
+__all__ = [
+    "GYM_ID",
+    "PETTINGZOO_ID",
+    "EnvConfig",
+    "FrontierExploreEnv",
+    "FrontierParallelEnv",
+    "ObservationConfig",
+    "RewardConfig",
+    "env",
+    "make_config",
+    "parallel_env",
+    "raw_env",
+]

@@ -1,0 +1,330 @@
+"""Environment configuration: frozen dataclasses, presets, and validation.
+
+Every parameter of the simulator lives here, is validated once when the config is built, and
+produces a ``ValueError`` that names the parameter and its allowed range. Presets reproduce the
+thesis's two geometries; any keyword overrides the preset::
+
+    cfg = make_config(preset="thesis-20x20", n_agents=2, centroid="relative")
+
+Options that the thesis left open are marked "open choice" below; ``docs/thesis-mapping.md``
+lists them with the reason for each default.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+CentroidEncoding = Literal["absolute", "relative", "distance", "none"]
+MapMode = Literal["static", "dynamic"]
+SensorModel = Literal["square", "raycast"]
+GainModel = Literal["size", "unknown"]
+ThresholdBasis = Literal["all", "free", "reachable"]
+RewardKind = Literal["reward1", "reward2"]
+FULL_PATH = "full"
+
+_CENTROIDS = ("absolute", "relative", "distance", "none")
+_MAP_MODES = ("static", "dynamic")
+_SENSORS = ("square", "raycast")
+_GAINS = ("size", "unknown")
+_BASES = ("all", "free", "reachable")
+_REWARDS = ("reward1", "reward2")
+
+
+@dataclass(frozen=True)
+class ObservationConfig:
+    """What each robot observes (the thesis's Table 4.1 axes).
+
+    Attributes:
+        centroid: encoding of each cluster slot's centroid: ``absolute`` (row, col),
+            ``relative`` (drow, dcol) to the robot, ``distance`` (Euclidean) only, or ``none``.
+        agent_position: include the robot's own (row, col); makes the observation a ``Dict``.
+        info_gain: include each slot's information gain.
+        sort_by_distance: order slots by increasing distance from the robot (else label order).
+        action_mask: add an ``action_mask`` key (valid slots) to a ``Dict`` observation.
+        normalize: divide positions by the map size and gains by the map area (open choice;
+            ``False`` keeps raw cell units as the thesis's description implies).
+    """
+
+    centroid: CentroidEncoding = "absolute"
+    agent_position: bool = True
+    info_gain: bool = False
+    sort_by_distance: bool = False
+    action_mask: bool = False
+    normalize: bool = False
+
+    def validate(self) -> None:
+        _check_choice("centroid", self.centroid, _CENTROIDS)
+        for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
+            _check_bool(name, getattr(self, name))
+        if self.centroid == "none" and not self.info_gain:
+            raise ValueError(
+                "observation is empty: centroid='none' needs info_gain=True "
+                "(the thesis's 'info gain only' layout)"
+            )
+
+    @property
+    def is_dict(self) -> bool:
+        """Whether the observation space is a ``Dict`` (else a flat ``Box``)."""
+        return self.agent_position or self.action_mask
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """The thesis's two reward tables (SPEC section 4) and their open parameters.
+
+    Attributes:
+        kind: ``reward1`` (harsh, padding truncates) or ``reward2`` (soft, oscillation penalty).
+        explore_threshold: explored fraction that ends the episode well (open choice).
+        threshold_basis: what the fraction counts: ``all`` cells known, ``free`` true-free
+            cells known, or ``reachable`` free cells reachable from the start that are known.
+        max_steps: decision steps before truncation with the step-limit penalty (open choice).
+        no_progress_limit: consecutive steps without a new cell that truncate the episode.
+        oscillation_window: Reward 2 penalises a step whose target differs from the previous
+            step's target but equals one of the targets chosen in the ``oscillation_window``
+            steps before that (A -> B -> A cycling). Open choice.
+        cell_reward: reward per newly known cell.
+        no_new_cell_penalty, padding_penalty, goal_bonus, step_limit_penalty,
+        no_progress_penalty, oscillation_penalty: the table's constants; ``padding_penalty``
+            defaults by ``kind`` (-1.0 for Reward 1, -0.1 for Reward 2) when left ``None``.
+    """
+
+    kind: RewardKind = "reward2"
+    explore_threshold: float = 0.95
+    threshold_basis: ThresholdBasis = "reachable"
+    max_steps: int = 400
+    no_progress_limit: int = 20
+    oscillation_window: int = 4
+    cell_reward: float = 0.05
+    no_new_cell_penalty: float = -0.05
+    padding_penalty: float | None = None
+    goal_bonus: float = 1.0
+    step_limit_penalty: float = -1.0
+    no_progress_penalty: float = -0.5
+    oscillation_penalty: float = -0.05
+
+    def validate(self) -> None:
+        _check_choice("reward", self.kind, _REWARDS)
+        _check_choice("threshold_basis", self.threshold_basis, _BASES)
+        _check_range("explore_threshold", self.explore_threshold, 0.0, 1.0, low_open=True)
+        _check_int("max_steps", self.max_steps, 1)
+        _check_int("no_progress_limit", self.no_progress_limit, 1)
+        _check_int("oscillation_window", self.oscillation_window, 1)
+        for name in (
+            "cell_reward",
+            "no_new_cell_penalty",
+            "goal_bonus",
+            "step_limit_penalty",
+            "no_progress_penalty",
+            "oscillation_penalty",
+        ):
+            _check_finite(name, getattr(self, name))
+        if self.padding_penalty is not None:
+            _check_finite("padding_penalty", self.padding_penalty)
+
+    @property
+    def padding(self) -> float:
+        """The padding-slot penalty in force."""
+        if self.padding_penalty is not None:
+            return self.padding_penalty
+        return -1.0 if self.kind == "reward1" else -0.1
+
+    @property
+    def padding_truncates(self) -> bool:
+        """Reward 1 truncates the episode when a padding slot is chosen."""
+        return self.kind == "reward1"
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """The whole simulator configuration.
+
+    Attributes:
+        height, width: grid size in cells.
+        n_agents: robots sharing one belief grid (1 = the thesis MDP).
+        obstacle_prob: probability that a cell is an obstacle (open choice).
+        map_mode: ``static`` (one layout from ``map_seed``) or ``dynamic`` (new layout per reset).
+        map_seed: seed of the static layout, recorded so results are comparable across runs.
+        perception_range: sensor range r in cells.
+        sensor: ``square`` (Chebyshev window, no occlusion) or ``raycast`` (Euclidean disc with
+            line of sight through free cells). Open choice.
+        cells_per_step: cells a robot moves per decision, or ``"full"`` to walk the whole path
+            to its target. Open choice.
+        connectivity: 4 or 8, the neighbourhood used to group frontier cells into clusters.
+        max_cluster_cells: clusters larger than this are split recursively (open choice).
+        n_slots: N_max, the number of cluster slots (the action space size).
+        gain: information gain of a cluster: its ``size`` or the ``unknown`` cells around it.
+        observation: see :class:`ObservationConfig`.
+        reward: see :class:`RewardConfig`.
+    """
+
+    height: int = 20
+    width: int = 20
+    n_agents: int = 1
+    obstacle_prob: float = 0.2
+    map_mode: MapMode = "static"
+    map_seed: int = 0
+    perception_range: int = 3
+    sensor: SensorModel = "square"
+    cells_per_step: int | str = 1
+    connectivity: int = 8
+    max_cluster_cells: int = 8
+    n_slots: int = 4
+    gain: GainModel = "size"
+    observation: ObservationConfig = field(default_factory=ObservationConfig)
+    reward: RewardConfig = field(default_factory=RewardConfig)
+
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` naming the first parameter out of its allowed range."""
+        _check_int("height", self.height, 3, 4096)
+        _check_int("width", self.width, 3, 4096)
+        _check_int("n_agents", self.n_agents, 1, 64)
+        _check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
+        _check_choice("map_mode", self.map_mode, _MAP_MODES)
+        _check_int("map_seed", self.map_seed, 0)
+        _check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
+        _check_choice("sensor", self.sensor, _SENSORS)
+        if self.cells_per_step != FULL_PATH:
+            _check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
+        if self.connectivity not in (4, 8) or isinstance(self.connectivity, bool):
+            raise ValueError(f"connectivity must be 4 or 8, got {self.connectivity!r}")
+        _check_int("max_cluster_cells", self.max_cluster_cells, 1)
+        _check_int("n_slots", self.n_slots, 1, 256)
+        _check_choice("gain", self.gain, _GAINS)
+        if not isinstance(self.observation, ObservationConfig):
+            raise ValueError("observation must be an ObservationConfig")
+        if not isinstance(self.reward, RewardConfig):
+            raise ValueError("reward must be a RewardConfig")
+        self.observation.validate()
+        self.reward.validate()
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.height, self.width)
+
+    @property
+    def walks_full_path(self) -> bool:
+        return self.cells_per_step == FULL_PATH
+
+    def replace(self, **overrides: Any) -> EnvConfig:
+        """A copy with flat overrides applied (see :func:`make_config` for the keys)."""
+        return _apply_overrides(self, overrides)
+
+
+#: Presets. ``thesis-30x30`` changes only size, perception range and the size-scaled limits
+#: (step limit and cluster split size scale with the map side / the perception range).
+PRESETS: dict[str, dict[str, Any]] = {
+    "thesis-20x20": {},
+    "thesis-30x30": {
+        "height": 30,
+        "width": 30,
+        "perception_range": 5,
+    },
+}
+
+_OBS_KEYS = {f.name for f in dataclasses.fields(ObservationConfig)}
+_REWARD_KEYS = {f.name for f in dataclasses.fields(RewardConfig)} - {"kind"}
+_ENV_KEYS = {f.name for f in dataclasses.fields(EnvConfig)} - {"observation", "reward"}
+
+
+def config_keys() -> list[str]:
+    """Every flat keyword accepted by :func:`make_config`."""
+    return sorted(_ENV_KEYS | _OBS_KEYS | _REWARD_KEYS | {"reward", "preset", "config"})
+
+
+def make_config(preset: str | None = "thesis-20x20", **overrides: Any) -> EnvConfig:
+    """Build a validated :class:`EnvConfig` from a preset plus flat keyword overrides.
+
+    Keys are the fields of :class:`EnvConfig`, :class:`ObservationConfig` and
+    :class:`RewardConfig` (``reward`` takes the reward kind, ``reward1`` or ``reward2``).
+    A ready ``EnvConfig`` may be passed as ``config=`` instead of a preset.
+    """
+    base = overrides.pop("config", None)
+    if base is None:
+        if preset is None:
+            preset = "thesis-20x20"
+        if preset not in PRESETS:
+            raise ValueError(f"preset must be one of {sorted(PRESETS)}, got {preset!r}")
+        base = _apply_overrides(EnvConfig(), dict(PRESETS[preset]))
+    elif not isinstance(base, EnvConfig):
+        raise ValueError(f"config must be an EnvConfig, got {type(base).__name__}")
+    return _apply_overrides(base, overrides)
+
+
+def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
+    unknown = set(overrides) - (_ENV_KEYS | _OBS_KEYS | _REWARD_KEYS | {"reward", "observation"})
+    if unknown:
+        raise ValueError(
+            f"unknown parameter(s) {sorted(unknown)}; allowed: {', '.join(config_keys())}"
+        )
+    env_kw = {k: v for k, v in overrides.items() if k in _ENV_KEYS}
+    obs_kw = {k: v for k, v in overrides.items() if k in _OBS_KEYS}
+    rew_kw = {k: v for k, v in overrides.items() if k in _REWARD_KEYS}
+    observation = overrides.get("observation", cfg.observation)
+    reward = cfg.reward
+    if "reward" in overrides:
+        value = overrides["reward"]
+        if isinstance(value, RewardConfig):
+            reward = value
+        else:
+            _check_choice("reward", value, _REWARDS)
+            rew_kw["kind"] = value
+    if isinstance(observation, ObservationConfig) and obs_kw:
+        observation = dataclasses.replace(observation, **obs_kw)
+    if isinstance(reward, RewardConfig) and rew_kw:
+        reward = dataclasses.replace(reward, **rew_kw)
+    return dataclasses.replace(cfg, observation=observation, reward=reward, **env_kw)
+
+
+def config_to_dict(cfg: EnvConfig) -> dict[str, Any]:
+    """A flat dictionary that :func:`make_config` turns back into ``cfg``."""
+    flat: dict[str, Any] = {k: getattr(cfg, k) for k in sorted(_ENV_KEYS)}
+    flat.update({k: getattr(cfg.observation, k) for k in sorted(_OBS_KEYS)})
+    flat.update({k: getattr(cfg.reward, k) for k in sorted(_REWARD_KEYS)})
+    flat["reward"] = cfg.reward.kind
+    return flat
+
+
+def _check_choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {list(choices)}, got {value!r}")
+
+
+def _check_bool(name: str, value: Any) -> None:
+    if not isinstance(value, bool):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+
+
+def _check_int(
+    name: str, value: Any, low: int, high: int | None = None, extra_allowed: str = ""
+) -> None:
+    import numbers
+
+    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if ok and value >= low and (high is None or value <= high):
+        return
+    allowed = f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]"
+    if extra_allowed:
+        allowed += f" or {extra_allowed}"
+    raise ValueError(f"{name} must be {allowed}, got {value!r}")
+
+
+def _check_finite(name: str, value: Any) -> None:
+    import math
+    import numbers
+
+    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+
+
+def _check_range(
+    name: str, value: Any, low: float, high: float, low_open: bool = False
+) -> None:
+    _check_finite(name, value)
+    if (value <= low if low_open else value < low) or value > high:
+        bracket = "(" if low_open else "["
+        raise ValueError(f"{name} must be in {bracket}{low}, {high}], got {value!r}")

@@ -1,0 +1,136 @@
+"""Sensor models: which cells a robot at a cell perceives, written into the belief grid.
+
+Both models are idealised (no noise): a perceived cell's belief becomes its true state.
+
+* :class:`SquareSensor` — every cell within Chebyshev distance ``r`` (a (2r+1)^2 window),
+  seen through walls.
+* :class:`RaycastSensor` — every cell within Euclidean distance ``r`` whose straight line of
+  sight from the robot's cell crosses no occupied cell (the occupied cell that blocks a ray is
+  itself seen).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from frontier_marl.core.grid import UNKNOWN
+
+
+class Sensor(Protocol):
+    range: int
+
+    def sense(
+        self,
+        true_grid: np.ndarray,
+        belief: np.ndarray,
+        cell: tuple[int, int],
+        seen: np.ndarray | None = None,
+    ) -> int:
+        """Write perceived cells into ``belief``; return how many were unknown before.
+
+        If ``seen`` (bool, grid-shaped) is given, every perceived cell is set True in it.
+        """
+        ...
+
+
+class SquareSensor:
+    """Chebyshev window of radius ``r``, no occlusion."""
+
+    def __init__(self, perception_range: int) -> None:
+        self.range = int(perception_range)
+
+    def window(self, shape: tuple[int, int], cell: tuple[int, int]) -> tuple[slice, slice]:
+        row, col = cell
+        r = self.range
+        return (
+            slice(max(0, row - r), min(shape[0], row + r + 1)),
+            slice(max(0, col - r), min(shape[1], col + r + 1)),
+        )
+
+    def sense(
+        self,
+        true_grid: np.ndarray,
+        belief: np.ndarray,
+        cell: tuple[int, int],
+        seen: np.ndarray | None = None,
+    ) -> int:
+        rows, cols = self.window(belief.shape, cell)
+        window = belief[rows, cols]
+        unknown = window == UNKNOWN
+        if seen is not None:
+            seen[rows, cols] = True
+        count = int(np.count_nonzero(unknown))
+        if count:
+            window[unknown] = true_grid[rows, cols][unknown]
+        return count
+
+
+class RaycastSensor:
+    """Euclidean disc of radius ``r`` with line-of-sight occlusion by occupied cells."""
+
+    def __init__(self, perception_range: int) -> None:
+        self.range = int(perception_range)
+        self._offsets, self._between = _rays(self.range)
+
+    def visible_cells(
+        self, true_grid: np.ndarray, cell: tuple[int, int]
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Row and column indices of the cells perceived from ``cell``."""
+        height, width = true_grid.shape
+        rows = self._offsets[:, 0] + cell[0]
+        cols = self._offsets[:, 1] + cell[1]
+        inside = (rows >= 0) & (rows < height) & (cols >= 0) & (cols < width)
+        rows, cols = rows[inside], cols[inside]
+        between = self._between[inside]
+        # Cells strictly between the robot and a target lie inside the grid whenever the
+        # target does, because they lie inside the bounding box of the two.
+        blocked = true_grid[between[..., 0] + cell[0], between[..., 1] + cell[1]].any(axis=1)
+        return rows[~blocked], cols[~blocked]
+
+    def sense(
+        self,
+        true_grid: np.ndarray,
+        belief: np.ndarray,
+        cell: tuple[int, int],
+        seen: np.ndarray | None = None,
+    ) -> int:
+        rows, cols = self.visible_cells(true_grid, cell)
+        if seen is not None:
+            seen[rows, cols] = True
+        unknown = belief[rows, cols] == UNKNOWN
+        count = int(np.count_nonzero(unknown))
+        if count:
+            rows, cols = rows[unknown], cols[unknown]
+            belief[rows, cols] = true_grid[rows, cols]
+        return count
+
+
+def _rays(radius: int) -> tuple[np.ndarray, np.ndarray]:
+    """Offsets in the disc, and for each the offsets strictly between it and the origin.
+
+    The in-between lists are padded with the origin (0, 0), which is the robot's own free cell
+    and so never blocks.
+    """
+    span = np.arange(-radius, radius + 1)
+    drow, dcol = np.meshgrid(span, span, indexing="ij")
+    inside = drow**2 + dcol**2 <= radius * radius
+    offsets = np.stack([drow[inside], dcol[inside]], axis=1)
+    longest = max(radius - 1, 1)
+    between = np.zeros((len(offsets), longest, 2), dtype=np.int64)
+    for i, (dr, dc) in enumerate(offsets):
+        steps = max(abs(int(dr)), abs(int(dc)))
+        for k in range(1, steps):
+            t = k / steps
+            between[i, k - 1] = (int(np.floor(dr * t + 0.5)), int(np.floor(dc * t + 0.5)))
+    return offsets.astype(np.int64), between
+
+
+def make_sensor(model: str, perception_range: int) -> Sensor:
+    """The sensor named ``model`` (``square`` or ``raycast``)."""
+    if model == "square":
+        return SquareSensor(perception_range)
+    if model == "raycast":
+        return RaycastSensor(perception_range)
+    raise ValueError(f"sensor must be 'square' or 'raycast', got {model!r}")

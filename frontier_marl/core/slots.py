@@ -1,0 +1,75 @@
+"""Cluster slots: which frontier clusters a robot may choose, and in which order.
+
+Rules (open choices of the thesis, documented in docs/thesis-mapping.md):
+
+* A cluster is *live* for a robot when one of its cells is reachable from the robot through
+  known-free cells; its navigation target is that reachable cell nearest the centroid.
+  Unreachable clusters are dropped (they never get a slot).
+* When more live clusters exist than slots, the ``n_slots`` nearest (Euclidean distance from
+  the robot to the centroid; ties by cluster index) get a slot.
+* The slots shown are ordered by increasing distance (``sort_by_distance``) or by cluster
+  index, i.e. raster order of the cluster's first cell. Ordering never changes which clusters
+  are selected.
+* Slots beyond the live clusters are padding: cluster -1, zero features, masked out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SlotTable:
+    """One robot's slots. Arrays have length ``n_slots``; padding rows hold zeros and -1."""
+
+    cluster: np.ndarray  # int (n,), cluster index or -1 for padding
+    valid: np.ndarray  # bool (n,)
+    centroid: np.ndarray  # float (n, 2)
+    target: np.ndarray  # int (n, 2), -1 for padding
+    distance: np.ndarray  # float (n,), Euclidean robot -> centroid
+    size: np.ndarray  # int (n,)
+    gain: np.ndarray  # float (n,)
+
+    @property
+    def live(self) -> int:
+        """How many slots hold a cluster."""
+        return int(self.valid.sum())
+
+
+def build_slots(
+    position: np.ndarray,
+    centroids: np.ndarray,
+    sizes: np.ndarray,
+    gains: np.ndarray,
+    has_target: np.ndarray,
+    targets: np.ndarray,
+    n_slots: int,
+    sort_by_distance: bool,
+) -> SlotTable:
+    """Select and order the slots of one robot at ``position`` (row, col)."""
+    live = np.flatnonzero(has_target)
+    distance = np.hypot(centroids[live, 0] - position[0], centroids[live, 1] - position[1])
+    if len(live) > n_slots:
+        keep = np.sort(np.argsort(distance, kind="stable")[:n_slots])
+        live, distance = live[keep], distance[keep]
+    if sort_by_distance:
+        order = np.argsort(distance, kind="stable")
+        live, distance = live[order], distance[order]
+    k = len(live)
+    cluster = np.full(n_slots, -1, dtype=np.int64)
+    cluster[:k] = live
+    valid = np.zeros(n_slots, dtype=bool)
+    valid[:k] = True
+    centroid = np.zeros((n_slots, 2))
+    centroid[:k] = centroids[live]
+    target = np.full((n_slots, 2), -1, dtype=np.int64)
+    target[:k] = targets[live]
+    dist = np.zeros(n_slots)
+    dist[:k] = distance
+    size = np.zeros(n_slots, dtype=np.int64)
+    size[:k] = sizes[live]
+    gain = np.zeros(n_slots)
+    gain[:k] = gains[live]
+    return SlotTable(cluster, valid, centroid, target, dist, size, gain)

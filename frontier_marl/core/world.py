@@ -1,0 +1,264 @@
+"""The world: true grid, one shared belief grid, robots, and the movement transition.
+
+Multi-robot rules (documented in docs/environment.md):
+
+* Robots move in sub-steps of one cell. In each sub-step they act in agent order; a robot
+  whose next cell is occupied by another robot *at that moment* waits (its path is kept).
+  Hence no two robots ever share a cell, and two robots can never swap cells (the first to
+  act finds the other's cell occupied and waits, then so does the second).
+* A robot senses at its start cell and at every cell it enters. A cell newly known in a
+  sub-step is credited to the first robot (in agent order) that sensed it, so the robots'
+  ``new_cells`` add up to the number of cells the team revealed.
+* Paths are planned with A* on the known-free cells (other robots are not obstacles; a
+  blocked robot waits). A plan is reused while the belief is unchanged and the target is the
+  same, which keeps it optimal (a suffix of a shortest path is a shortest path).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from frontier_marl.core.frontiers import (
+    Clusters,
+    cluster_frontiers,
+    free_components,
+    nearest_cells_to_centroids,
+    unknown_around,
+)
+from frontier_marl.core.grid import FREE, UNKNOWN, new_belief
+from frontier_marl.core.maps import FOUR_CONNECTED
+from frontier_marl.core.planning import astar
+from frontier_marl.core.sensing import Sensor
+from frontier_marl.core.slots import SlotTable, build_slots
+
+FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
+
+
+@dataclass(frozen=True)
+class WorldParams:
+    """Static parameters of the world transition."""
+
+    sensor: Sensor
+    cells_per_step: int  # >= 1, or FULL_PATH
+    connectivity: int = 8
+    max_cluster_cells: int = 0
+    gain: str = "size"  # or "unknown"
+
+
+@dataclass(frozen=True)
+class MoveResult:
+    """What one transition did, per robot."""
+
+    new_cells: np.ndarray  # int (N,), cells first revealed by each robot
+    paths: list[np.ndarray]  # per robot, (L, 2) cells occupied this step, start included
+    reached: np.ndarray  # bool (N,), robot stands on its target
+
+
+class World:
+    """Mutable state of one episode. Read it through the read-only array properties."""
+
+    def __init__(
+        self, true_grid: np.ndarray, starts: np.ndarray, params: WorldParams
+    ) -> None:
+        true_grid = np.asarray(true_grid, dtype=bool)
+        starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+        if true_grid[starts[:, 0], starts[:, 1]].any():
+            raise ValueError("every start cell must be free")
+        if len({tuple(s) for s in starts.tolist()}) != len(starts):
+            raise ValueError("start cells must be distinct")
+        self.params = params
+        self._true = true_grid
+        self._true.setflags(write=False)
+        self._belief = new_belief(true_grid.shape)
+        self._positions = starts.copy()
+        self._seen = np.zeros((len(starts),) + true_grid.shape, dtype=bool)
+        self._travelled = np.zeros(len(starts), dtype=np.int64)
+        # Per robot: (target, remaining path from the robot's cell, belief version planned on).
+        self._plans: list[tuple[tuple[int, int], np.ndarray, int] | None] = [None] * len(starts)
+        self._version = 0
+        self._cache_version = -1
+        self._cache: tuple[Clusters, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._passable_version = -1
+        self._passable = np.zeros_like(true_grid)
+        self._start_region = _reachable_region(true_grid, starts)
+        self._true_free_count = int(np.count_nonzero(~true_grid))
+        for agent in range(len(starts)):
+            self._sense(agent)
+
+    # ----------------------------------------------------------------- read-only state
+    @property
+    def true_grid(self) -> np.ndarray:
+        return self._true
+
+    @property
+    def belief(self) -> np.ndarray:
+        return _read_only(self._belief)
+
+    @property
+    def positions(self) -> np.ndarray:
+        return _read_only(self._positions)
+
+    @property
+    def seen(self) -> np.ndarray:
+        """(N, H, W) bool: cells each robot has perceived at least once."""
+        return _read_only(self._seen)
+
+    @property
+    def travelled(self) -> np.ndarray:
+        """Cells moved by each robot since the start."""
+        return _read_only(self._travelled)
+
+    @property
+    def start_region(self) -> np.ndarray:
+        """Free cells reachable from the start cells on the true grid."""
+        return _read_only(self._start_region)
+
+    @property
+    def n_agents(self) -> int:
+        return len(self._positions)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self._true.shape
+
+    def explored_fraction(self, basis: str) -> float:
+        """Fraction of ``all`` cells known, of true-``free`` cells known free, or of the
+        ``reachable`` free region known."""
+        if basis == "all":
+            return float(np.count_nonzero(self._belief != UNKNOWN)) / self._belief.size
+        if basis == "free":
+            return float(np.count_nonzero(self._belief == FREE)) / max(self._true_free_count, 1)
+        if basis == "reachable":
+            known = np.count_nonzero(self._belief[self._start_region] != UNKNOWN)
+            return float(known) / max(int(np.count_nonzero(self._start_region)), 1)
+        raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
+
+    # ----------------------------------------------------------------- frontier view
+    def clusters(self) -> Clusters:
+        """Frontier clusters of the current belief (cached until the belief changes)."""
+        return self._frontier_cache()[0]
+
+    def cluster_gains(self) -> np.ndarray:
+        return self._frontier_cache()[1]
+
+    def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
+        """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""
+        clusters, gains, components, cell_component = self._frontier_cache()
+        row, col = self._positions[agent]
+        eligible = cell_component == components[row, col]
+        has_target, targets = nearest_cells_to_centroids(clusters, eligible)
+        return build_slots(
+            self._positions[agent],
+            clusters.centroids,
+            clusters.sizes,
+            gains,
+            has_target,
+            targets,
+            n_slots,
+            sort_by_distance,
+        )
+
+    def _frontier_cache(self) -> tuple[Clusters, np.ndarray, np.ndarray, np.ndarray]:
+        if self._cache_version != self._version or self._cache is None:
+            p = self.params
+            clusters = cluster_frontiers(self._belief, p.connectivity, p.max_cluster_cells)
+            if p.gain == "unknown":
+                gains = unknown_around(self._belief, clusters).astype(float)
+            else:
+                gains = clusters.sizes.astype(float)
+            components = free_components(self._belief)
+            cell_component = components[clusters.cell_rows, clusters.cell_cols]
+            self._cache = (clusters, gains, components, cell_component)
+            self._cache_version = self._version
+        return self._cache
+
+    # ----------------------------------------------------------------- transition
+    def plan(self, agent: int, target: tuple[int, int]) -> np.ndarray | None:
+        """Shortest path (L, 2) from robot ``agent`` to ``target`` over known-free cells."""
+        position = (int(self._positions[agent, 0]), int(self._positions[agent, 1]))
+        cached = self._plans[agent]
+        if cached is not None and cached[0] == target and cached[2] == self._version:
+            path = cached[1]
+            if len(path) and (int(path[0, 0]), int(path[0, 1])) == position:
+                return path
+        if self._passable_version != self._version:
+            np.equal(self._belief, FREE, out=self._passable)
+            self._passable_version = self._version
+        path = astar(self._passable, position, target)
+        self._plans[agent] = None if path is None else (target, path, self._version)
+        return path
+
+    def move(self, targets: list[tuple[int, int] | None]) -> MoveResult:
+        """Move each robot toward its target (``None`` = stay) and sense on the way.
+
+        Each robot advances ``cells_per_step`` cells along its A* path, or all the way when
+        ``cells_per_step`` is ``FULL_PATH``, stopping early at its target.
+        """
+        n = self.n_agents
+        if len(targets) != n:
+            raise ValueError(f"expected {n} targets, got {len(targets)}")
+        remaining: list[np.ndarray] = []
+        for agent, target in enumerate(targets):
+            path = None if target is None else self.plan(agent, target)
+            remaining.append(path[1:] if path is not None else np.zeros((0, 2), np.int64))
+        walked: list[list[tuple[int, int]]] = [
+            [(int(r), int(c))] for r, c in self._positions
+        ]
+        new_cells = np.zeros(n, dtype=np.int64)
+        budget = self.params.cells_per_step
+        progress = [0] * n
+        occupied = {cell[0] for cell in walked}
+        sub_step = 0
+        while budget == FULL_PATH or sub_step < budget:
+            moved = False
+            for agent in range(n):
+                if progress[agent] >= len(remaining[agent]):
+                    continue
+                nxt = (int(remaining[agent][progress[agent], 0]),
+                       int(remaining[agent][progress[agent], 1]))
+                if nxt in occupied:
+                    continue
+                occupied.discard(walked[agent][-1])
+                occupied.add(nxt)
+                self._positions[agent] = nxt
+                walked[agent].append(nxt)
+                progress[agent] += 1
+                self._travelled[agent] += 1
+                new_cells[agent] += self._sense(agent)
+                moved = True
+            sub_step += 1
+            if not moved:
+                break
+        for agent in range(n):
+            plan = self._plans[agent]
+            if plan is not None and progress[agent]:
+                self._plans[agent] = (plan[0], plan[1][progress[agent] :], plan[2])
+        reached = np.array(
+            [len(remaining[a]) > 0 and progress[a] == len(remaining[a]) for a in range(n)]
+        )
+        paths = [np.array(w, dtype=np.int64) for w in walked]
+        return MoveResult(new_cells, paths, reached)
+
+    def _sense(self, agent: int) -> int:
+        row, col = self._positions[agent]
+        count = self.params.sensor.sense(
+            self._true, self._belief, (int(row), int(col)), self._seen[agent]
+        )
+        if count:
+            self._version += 1
+        return count
+
+
+def _reachable_region(true_grid: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    labels, _ = ndimage.label(~true_grid, structure=FOUR_CONNECTED)
+    ids = np.unique(labels[starts[:, 0], starts[:, 1]])
+    return np.isin(labels, ids)
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    view = array.view()
+    view.setflags(write=False)
+    return view

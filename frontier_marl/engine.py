@@ -1,0 +1,237 @@
+"""The decision process shared by the PettingZoo and Gymnasium adapters.
+
+:class:`ExplorationMDP` owns a :class:`~frontier_marl.core.world.World` and turns one action per
+robot (a cluster slot index) into targets, moves the robots, applies the reward table, and
+encodes the next observations. It holds no RNG of its own: ``reset`` takes a
+``numpy.random.Generator`` from the adapter, so one seed fixes the whole episode.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.maps import largest_free_component, random_obstacle_map, sample_start_cells
+from frontier_marl.core.sensing import make_sensor
+from frontier_marl.core.slots import SlotTable
+from frontier_marl.core.world import FULL_PATH, World, WorldParams
+from frontier_marl.observations import ObservationEncoder
+from frontier_marl.rewards import OscillationDetector, StepEvents, step_outcome
+
+Observation = np.ndarray | dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class Transition:
+    """Result of one decision step for all robots (lists are indexed by robot)."""
+
+    observations: list[Observation]
+    rewards: np.ndarray
+    terminated: bool
+    truncated: bool
+    infos: list[dict[str, Any]]
+
+
+class ExplorationMDP:
+    """Frontier-selection MDP for ``cfg.n_agents`` robots on one shared belief grid."""
+
+    def __init__(self, cfg: EnvConfig) -> None:
+        self.cfg = cfg
+        self.encoder = ObservationEncoder(cfg)
+        self.params = WorldParams(
+            sensor=make_sensor(cfg.sensor, cfg.perception_range),
+            cells_per_step=FULL_PATH if cfg.walks_full_path else int(cfg.cells_per_step),
+            connectivity=cfg.connectivity,
+            max_cluster_cells=cfg.max_cluster_cells,
+            gain=cfg.gain,
+        )
+        self._static_map: np.ndarray | None = None
+        self.world: World | None = None
+        self._slots: list[SlotTable] = []
+        self._oscillation: list[OscillationDetector] = []
+        self.steps = 0
+        self.steps_without_progress = 0
+        self.done = True
+
+    # ------------------------------------------------------------------ episode
+    def true_grid_for_episode(self, rng: np.random.Generator) -> np.ndarray:
+        """The static layout (from ``map_seed``) or a fresh dynamic one (from ``rng``)."""
+        cfg = self.cfg
+        if cfg.map_mode == "static":
+            if self._static_map is None:
+                map_rng = np.random.default_rng(cfg.map_seed)
+                self._static_map = random_obstacle_map(
+                    cfg.height, cfg.width, cfg.obstacle_prob, map_rng
+                )
+            return self._static_map
+        return random_obstacle_map(cfg.height, cfg.width, cfg.obstacle_prob, rng)
+
+    def reset(
+        self, rng: np.random.Generator
+    ) -> tuple[list[Observation], list[dict[str, Any]]]:
+        """Start an episode: map, start cells in the largest free component, first sensing."""
+        cfg = self.cfg
+        true_grid = self.true_grid_for_episode(rng)
+        starts = sample_start_cells(largest_free_component(true_grid), cfg.n_agents, rng)
+        self.world = World(true_grid.copy(), starts, self.params)
+        self._oscillation = [
+            OscillationDetector(cfg.reward.oscillation_window) for _ in range(cfg.n_agents)
+        ]
+        self.steps = 0
+        self.steps_without_progress = 0
+        self.done = False
+        self._refresh_slots()
+        n = cfg.n_agents
+        empty_paths = [self.world.positions[i][None, :].copy() for i in range(n)]
+        infos = self._infos(
+            np.zeros(n, np.int64), empty_paths, [None] * n, np.zeros(n, bool), np.zeros(n, bool), ""
+        )
+        return self._observations(), infos
+
+    def step(self, actions: list[Any]) -> Transition:
+        """One decision per robot: ``actions[i]`` is robot i's slot index."""
+        if self.world is None or self.done:
+            raise RuntimeError("step() called before reset() or after the episode ended")
+        cfg = self.cfg
+        n = cfg.n_agents
+        if len(actions) != n:
+            raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
+        targets: list[tuple[int, int] | None] = []
+        padding = np.zeros(n, dtype=bool)
+        for agent, action in enumerate(actions):
+            slot = self._check_action(action, agent)
+            table = self._slots[agent]
+            if table.valid[slot]:
+                row, col = table.target[slot]
+                targets.append((int(row), int(col)))
+            else:
+                targets.append(None)
+                padding[agent] = table.live > 0
+        oscillation = np.array(
+            [detector.update(t) for detector, t in zip(self._oscillation, targets, strict=True)]
+        )
+        moved = self.world.move(targets)
+        self.steps += 1
+        revealed = int(moved.new_cells.sum())
+        self.steps_without_progress = 0 if revealed else self.steps_without_progress + 1
+        self._refresh_slots()
+        fraction = self.world.explored_fraction(cfg.reward.threshold_basis)
+        events = StepEvents(
+            new_cells=moved.new_cells,
+            padding=padding,
+            oscillation=oscillation,
+            threshold_reached=fraction >= cfg.reward.explore_threshold,
+            no_frontier_left=all(table.live == 0 for table in self._slots),
+            steps_taken=self.steps,
+            steps_without_progress=self.steps_without_progress,
+        )
+        outcome = step_outcome(cfg.reward, events)
+        self.done = outcome.terminated or outcome.truncated
+        infos = self._infos(
+            moved.new_cells, moved.paths, targets, padding, oscillation, outcome.reason
+        )
+        return Transition(
+            self._observations(), outcome.rewards, outcome.terminated, outcome.truncated, infos
+        )
+
+    # ------------------------------------------------------------------ helpers
+    def _check_action(self, action: Any, agent: int) -> int:
+        value = action
+        if isinstance(value, np.ndarray):
+            if value.size != 1:
+                raise ValueError(
+                    f"action of robot {agent} must be one integer slot index, "
+                    f"got an array of shape {value.shape}"
+                )
+            value = value.reshape(()).item()
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise TypeError(
+                f"action of robot {agent} must be an integer slot index, "
+                f"got {type(action).__name__} {action!r}"
+            )
+        if not 0 <= value < self.cfg.n_slots:
+            raise ValueError(
+                f"action of robot {agent} must be in [0, {self.cfg.n_slots - 1}] "
+                f"(n_slots={self.cfg.n_slots}), got {value}"
+            )
+        return int(value)
+
+    def _refresh_slots(self) -> None:
+        assert self.world is not None
+        sort = self.cfg.observation.sort_by_distance
+        self._slots = [
+            self.world.slots(agent, self.cfg.n_slots, sort) for agent in range(self.cfg.n_agents)
+        ]
+
+    def slot_tables(self) -> list[SlotTable]:
+        """The slot tables the robots observe now (the ones their next actions refer to)."""
+        return list(self._slots)
+
+    def action_masks(self) -> list[np.ndarray]:
+        """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
+        masks = []
+        for table in self._slots:
+            mask = table.valid.astype(np.int8)
+            if table.live == 0:
+                mask[0] = 1
+            masks.append(mask)
+        return masks
+
+    def _observations(self) -> list[Observation]:
+        assert self.world is not None
+        positions = self.world.positions
+        return [
+            self.encoder.encode(table, positions[agent])
+            for agent, table in enumerate(self._slots)
+        ]
+
+    def _infos(
+        self,
+        new_cells: np.ndarray,
+        paths: list[np.ndarray],
+        targets: list[tuple[int, int] | None],
+        padding: np.ndarray,
+        oscillation: np.ndarray,
+        reason: str,
+    ) -> list[dict[str, Any]]:
+        assert self.world is not None
+        world = self.world
+        fraction = world.explored_fraction(self.cfg.reward.threshold_basis)
+        coverage = world.explored_fraction("reachable")
+        masks = self.action_masks()
+        infos = []
+        for agent, table in enumerate(self._slots):
+            clusters = [
+                {
+                    "slot": slot,
+                    "cluster": int(table.cluster[slot]),
+                    "centroid": (float(table.centroid[slot, 0]), float(table.centroid[slot, 1])),
+                    "target": (int(table.target[slot, 0]), int(table.target[slot, 1])),
+                    "size": int(table.size[slot]),
+                    "gain": float(table.gain[slot]),
+                    "distance": float(table.distance[slot]),
+                }
+                for slot in np.flatnonzero(table.valid).tolist()
+            ]
+            infos.append(
+                {
+                    "explored_fraction": fraction,
+                    "coverage": coverage,
+                    "new_cells": int(new_cells[agent]),
+                    "action_mask": masks[agent],
+                    "clusters": clusters,
+                    "path": paths[agent],
+                    "target": targets[agent],
+                    "position": (int(world.positions[agent, 0]), int(world.positions[agent, 1])),
+                    "travelled": int(world.travelled[agent]),
+                    "padding": bool(padding[agent]),
+                    "oscillation": bool(oscillation[agent]),
+                    "step": self.steps,
+                    "end_reason": reason,
+                }
+            )
+        return infos

@@ -1,0 +1,70 @@
+"""Rendering shared by the adapters: a frame of the MDP's current state in any render mode."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.engine import ExplorationMDP
+from frontier_marl.render import render_ansi, render_rgb
+
+RENDER_MODES = ["human", "rgb_array", "ansi"]
+
+
+def check_render_mode(render_mode: str | None) -> None:
+    if render_mode is not None and render_mode not in RENDER_MODES:
+        raise ValueError(f"render_mode must be one of {RENDER_MODES} or None, got {render_mode!r}")
+
+
+def frame(mdp: ExplorationMDP, last_infos: list[dict[str, Any]] | None, mode: str) -> Any:
+    """An RGB frame (``rgb_array``/``human``) or a text map (``ansi``) of the current state."""
+    world = mdp.world
+    if world is None:
+        raise RuntimeError("render() called before reset()")
+    clusters = world.clusters()
+    labels = clusters.labels()
+    if mode == "ansi":
+        return render_ansi(world.belief, world.positions, labels)
+    paths = [info["path"] for info in last_infos] if last_infos else None
+    targets = np.full((world.n_agents, 2), -1, dtype=np.int64)
+    for agent, info in enumerate(last_infos or []):
+        if info.get("target") is not None:
+            targets[agent] = info["target"]
+    return render_rgb(
+        world.true_grid,
+        world.belief,
+        world.positions,
+        cluster_labels=labels,
+        centroids=clusters.centroids,
+        paths=paths,
+        targets=targets,
+    )
+
+
+class Renderer:
+    """Renders the MDP in one mode; owns the matplotlib window in ``human`` mode."""
+
+    def __init__(self, render_mode: str | None, fps: float) -> None:
+        check_render_mode(render_mode)
+        self.mode = render_mode
+        self.fps = fps
+        self._viewer: Any = None
+
+    def render(self, mdp: ExplorationMDP, last_infos: list[dict[str, Any]] | None) -> Any:
+        if self.mode is None:
+            return None
+        image = frame(mdp, last_infos, self.mode)
+        if self.mode != "human":
+            return image
+        if self._viewer is None:
+            from frontier_marl.render import HumanViewer
+
+            self._viewer = HumanViewer(fps=self.fps)
+        self._viewer.show(image)
+        return None
+
+    def close(self) -> None:
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None

@@ -1,0 +1,154 @@
+"""PettingZoo ParallelEnv adapter over :class:`~frontier_marl.engine.ExplorationMDP`."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from frontier_marl.config import EnvConfig, make_config
+from frontier_marl.core.world import World
+from frontier_marl.engine import ExplorationMDP
+from frontier_marl.envs.common import RENDER_MODES, Renderer
+
+
+class FrontierParallelEnv(ParallelEnv):
+    """Frontier-based exploration by N robots sharing one belief grid (frontier_explore_v0).
+
+    **Description.** A team of robots explores an unknown 2D grid. At each decision step every
+    robot picks one *slot*: a frontier cluster (contiguous known-free cells next to unknown
+    ones). A* plans a path to the cluster's target cell over known-free cells; the robot walks
+    ``cells_per_step`` cells of it (or all of it) and senses at every cell it enters. All robots
+    write into one shared belief grid. With one robot this is exactly the thesis's MDP.
+
+    **Agents.** ``robot_0`` ... ``robot_{N-1}``; all act every step; all leave together.
+
+    **Action space.** ``Discrete(n_slots)``: the slot index. Slots beyond the live clusters are
+    padding: choosing one is legal and is handled by the reward table. The valid slots are in
+    ``info[agent]["action_mask"]`` (and in the observation when ``action_mask=True``).
+
+    **Observation space.** A flat ``Box`` of ``n_slots x F`` slot features, or a ``Dict`` with
+    ``clusters``, ``agent_position`` and ``action_mask`` keys; see
+    :mod:`frontier_marl.observations`.
+
+    **Rewards.** Reward 1 or Reward 2 of the thesis (:mod:`frontier_marl.rewards`).
+
+    **Starting state.** The static layout (``map_seed``) or a fresh random layout (dynamic);
+    robots start on distinct random cells of the largest free component and sense there.
+
+    **Episode end.** Terminated when the explored fraction reaches ``explore_threshold`` or no
+    robot has a reachable frontier left; truncated by the step limit, by ``no_progress_limit``
+    steps without a new cell, or (Reward 1) by a padding action.
+
+    **Arguments.** ``preset`` (``thesis-20x20`` or ``thesis-30x30``), ``render_mode``, and any
+    field of :class:`~frontier_marl.config.EnvConfig` / ``ObservationConfig`` /
+    ``RewardConfig`` as a flat keyword (``config=EnvConfig(...)`` also works). Every value is
+    validated at construction.
+
+    **Info.** Per agent: ``explored_fraction``, ``coverage`` (of the reachable free region),
+    ``new_cells``, ``action_mask``, ``clusters`` (slot, cluster, centroid, target, size, gain,
+    distance for each live slot), ``path`` (cells occupied this step, start included),
+    ``target``, ``position``, ``travelled``, ``padding``, ``oscillation``, ``step``,
+    ``end_reason``.
+
+    **Version history.** v0: first release.
+    """
+
+    metadata = {
+        "name": "frontier_explore_v0",
+        "render_modes": RENDER_MODES,
+        "render_fps": 4,
+        "is_parallelizable": True,
+    }
+
+    def __init__(
+        self, preset: str | None = "thesis-20x20", render_mode: str | None = None, **kwargs: Any
+    ) -> None:
+        self._renderer = Renderer(render_mode, self.metadata["render_fps"])
+        self.config: EnvConfig = make_config(preset, **kwargs)
+        self.render_mode = render_mode
+        self._mdp = ExplorationMDP(self.config)
+        self.possible_agents = [f"robot_{i}" for i in range(self.config.n_agents)]
+        self.agents: list[str] = []
+        self._obs_space = self._mdp.encoder.space
+        self._act_space = spaces.Discrete(self.config.n_slots)
+        self.observation_spaces = dict.fromkeys(self.possible_agents, self._obs_space)
+        self.action_spaces = dict.fromkeys(self.possible_agents, self._act_space)
+        self._rng: np.random.Generator | None = None
+        self._last_infos: list[dict[str, Any]] | None = None
+
+    def observation_space(self, agent: str) -> spaces.Space[Any]:
+        return self._obs_space
+
+    def action_space(self, agent: str) -> spaces.Space[Any]:
+        return self._act_space
+
+    @property
+    def world(self) -> World:
+        """The current world (read-only arrays: ``true_grid``, ``belief``, ``positions``...)."""
+        if self._mdp.world is None:
+            raise RuntimeError("the world exists after reset()")
+        return self._mdp.world
+
+    @property
+    def mdp(self) -> ExplorationMDP:
+        return self._mdp
+
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+        if seed is not None or self._rng is None:
+            self._rng = np.random.default_rng(seed)
+            self._act_space.seed(None if seed is None else seed + 1)
+        observations, infos = self._mdp.reset(self._rng)
+        self.agents = list(self.possible_agents)
+        self._last_infos = infos
+        if self.render_mode == "human":
+            self.render()
+        return dict(zip(self.agents, observations, strict=True)), dict(
+            zip(self.agents, infos, strict=True)
+        )
+
+    def step(
+        self, actions: dict[str, Any]
+    ) -> tuple[
+        dict[str, Any],
+        dict[str, float],
+        dict[str, bool],
+        dict[str, bool],
+        dict[str, dict[str, Any]],
+    ]:
+        if not self.agents:
+            raise RuntimeError("step() called with no live agents: call reset() first")
+        missing = [agent for agent in self.agents if agent not in actions]
+        extra = [agent for agent in actions if agent not in self.agents]
+        if missing or extra:
+            raise ValueError(
+                f"actions must have one entry per live agent {self.agents}; "
+                f"missing {missing}, unexpected {extra}"
+            )
+        agents = self.agents
+        result = self._mdp.step([actions[agent] for agent in agents])
+        self._last_infos = result.infos
+        observations = dict(zip(agents, result.observations, strict=True))
+        rewards = {agent: float(r) for agent, r in zip(agents, result.rewards, strict=True)}
+        terminations = dict.fromkeys(agents, result.terminated)
+        truncations = dict.fromkeys(agents, result.truncated)
+        infos = dict(zip(agents, result.infos, strict=True))
+        if result.terminated or result.truncated:
+            self.agents = []
+        if self.render_mode == "human":
+            self.render()
+        return observations, rewards, terminations, truncations, infos
+
+    def render(self) -> Any:
+        return self._renderer.render(self._mdp, self._last_infos)
+
+    def close(self) -> None:
+        self._renderer.close()
+
+    def state(self) -> np.ndarray:
+        """The shared belief grid (int8, -1 unknown / 0 free / 1 occupied)."""
+        return np.array(self.world.belief)

@@ -1,0 +1,123 @@
+"""Observation encoders: one robot's slot table and position -> the observation the agent sees.
+
+Layout (the thesis's Table 4.1 axes, see :class:`~frontier_marl.config.ObservationConfig`):
+
+* ``clusters``: a flat float32 vector of ``n_slots * F`` values, slot-major. Per slot, in order:
+  the centroid encoding (``absolute``: row, col; ``relative``: drow, dcol = centroid - robot;
+  ``distance``: Euclidean distance; ``none``: nothing), then the information gain if enabled.
+  Padding slots are all zeros.
+* Without the agent position (and without ``action_mask``) the observation *is* that vector
+  (a ``Box``, for SB3's ``MlpPolicy``). Otherwise it is a ``Dict`` with keys ``clusters``,
+  ``agent_position`` (row, col) when enabled, and ``action_mask`` (int8, 1 = valid slot) when
+  enabled (for SB3's ``MultiInputPolicy``).
+* With ``normalize``, rows are divided by the height, columns by the width, distances by the
+  diagonal and gains by their upper bound, so every value lies in [-1, 1].
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import SlotTable
+
+
+class ObservationEncoder:
+    """Builds the observation space once and encodes slot tables into it."""
+
+    def __init__(self, cfg: EnvConfig) -> None:
+        obs = cfg.observation
+        self.cfg = cfg
+        self.n_slots = cfg.n_slots
+        self.centroid = obs.centroid
+        self.info_gain = obs.info_gain
+        self.agent_position = obs.agent_position
+        self.action_mask = obs.action_mask
+        self.is_dict = obs.is_dict
+        height, width = cfg.height, cfg.width
+        gain_high = float(cfg.max_cluster_cells if cfg.gain == "size" else 8 * cfg.max_cluster_cells)
+        gain_high = min(gain_high, float(height * width))
+        low, high, scale = [], [], []
+        if self.centroid == "absolute":
+            low += [0.0, 0.0]
+            high += [height - 1.0, width - 1.0]
+            scale += [float(height), float(width)]
+        elif self.centroid == "relative":
+            low += [-(height - 1.0), -(width - 1.0)]
+            high += [height - 1.0, width - 1.0]
+            scale += [float(height), float(width)]
+        elif self.centroid == "distance":
+            low += [0.0]
+            high += [math.hypot(height - 1, width - 1)]
+            scale += [math.hypot(height, width)]
+        if self.info_gain:
+            low += [0.0]
+            high += [gain_high]
+            scale += [gain_high]
+        self.features_per_slot = len(low)
+        self._scale = np.array(scale if obs.normalize else [1.0] * len(scale), dtype=np.float64)
+        self._position_scale = (
+            np.array([height, width], dtype=np.float64) if obs.normalize else np.ones(2)
+        )
+        low_arr = np.tile(np.array(low) / self._scale, self.n_slots).astype(np.float32)
+        high_arr = np.tile(np.array(high) / self._scale, self.n_slots).astype(np.float32)
+        cluster_space = spaces.Box(low_arr, high_arr, dtype=np.float32)
+        if not self.is_dict:
+            self.space: spaces.Space[Any] = cluster_space
+            return
+        entries: dict[str, spaces.Space[Any]] = {"clusters": cluster_space}
+        if self.agent_position:
+            pos_high = (np.array([height - 1, width - 1]) / self._position_scale).astype(np.float32)
+            entries["agent_position"] = spaces.Box(
+                np.zeros(2, np.float32), pos_high, dtype=np.float32
+            )
+        if self.action_mask:
+            entries["action_mask"] = spaces.Box(0, 1, (self.n_slots,), dtype=np.int8)
+        self.space = spaces.Dict(entries)
+
+    def encode(self, slots: SlotTable, position: np.ndarray) -> np.ndarray | dict[str, np.ndarray]:
+        """The observation of a robot at ``position`` with slot table ``slots``."""
+        features = np.zeros((self.n_slots, self.features_per_slot), dtype=np.float64)
+        k = slots.live
+        column = 0
+        if self.centroid == "absolute":
+            features[:k, 0:2] = slots.centroid[:k]
+            column = 2
+        elif self.centroid == "relative":
+            features[:k, 0:2] = slots.centroid[:k] - position
+            column = 2
+        elif self.centroid == "distance":
+            features[:k, 0] = slots.distance[:k]
+            column = 1
+        if self.info_gain:
+            features[:k, column] = slots.gain[:k]
+        flat = (features / self._scale).astype(np.float32).ravel()
+        if not self.is_dict:
+            return flat
+        out: dict[str, np.ndarray] = {"clusters": flat}
+        if self.agent_position:
+            out["agent_position"] = (position / self._position_scale).astype(np.float32)
+        if self.action_mask:
+            out["action_mask"] = slots.valid.astype(np.int8)
+        return out
+
+
+def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
+    """A JSON-able description of the observation layout, used to check saved models."""
+    enc = ObservationEncoder(cfg)
+    return {
+        "centroid": enc.centroid,
+        "info_gain": enc.info_gain,
+        "agent_position": enc.agent_position,
+        "action_mask": enc.action_mask,
+        "sort_by_distance": cfg.observation.sort_by_distance,
+        "normalize": cfg.observation.normalize,
+        "n_slots": enc.n_slots,
+        "features_per_slot": enc.features_per_slot,
+        "height": cfg.height,
+        "width": cfg.width,
+    }
