@@ -1,0 +1,5 @@
+import sys
+
+from frontier_marl.cli import main
+
+sys.exit(main())
