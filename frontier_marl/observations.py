@@ -39,8 +39,8 @@ class ObservationEncoder:
         self.action_mask = obs.action_mask
         self.is_dict = obs.is_dict
         height, width = cfg.height, cfg.width
-        gain_high = float(cfg.max_cluster_cells if cfg.gain == "size" else 8 * cfg.max_cluster_cells)
-        gain_high = min(gain_high, float(height * width))
+        cells = cfg.max_cluster_cells
+        gain_high = min(float(cells if cfg.gain == "size" else 8 * cells), float(height * width))
         low, high, scale = [], [], []
         if self.centroid == "absolute":
             low += [0.0, 0.0]

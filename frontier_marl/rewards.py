@@ -75,11 +75,20 @@ class StepOutcome:
 
 def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
     """Apply the reward table to one step's events."""
-    new_cells = events.new_cells
-    rewards = np.where(new_cells > 0, cfg.cell_reward * new_cells, cfg.no_new_cell_penalty)
-    rewards = rewards + np.where(events.padding, cfg.padding, 0.0)
-    if cfg.kind == "reward2":
-        rewards = rewards + np.where(events.oscillation, cfg.oscillation_penalty, 0.0)
+    padding = cfg.padding
+    oscillation = cfg.oscillation_penalty if cfg.kind == "reward2" else 0.0
+    values = []
+    for new, pad, osc in zip(
+        events.new_cells.tolist(), events.padding.tolist(), events.oscillation.tolist(),
+        strict=True,
+    ):
+        value = cfg.cell_reward * new if new > 0 else cfg.no_new_cell_penalty
+        if pad:
+            value += padding
+        if osc:
+            value += oscillation
+        values.append(value)
+    rewards = np.array(values)
     if events.threshold_reached:
         return StepOutcome(rewards + cfg.goal_bonus, True, False, "threshold")
     if events.no_frontier_left:

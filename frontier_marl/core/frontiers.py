@@ -81,42 +81,43 @@ def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int 
         raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
     mask = frontier_mask(belief)
     flat = np.flatnonzero(mask)
-    width = belief.shape[1]
-    rows, cols = np.divmod(flat, width)
     if flat.size == 0:
         empty = np.zeros(0, dtype=np.int64)
         return Clusters(belief.shape, empty, empty, empty, empty, np.zeros((0, 2)))
+    rows, cols = np.divmod(flat, belief.shape[1])
     image, count = ndimage.label(mask, structure=_STRUCTURES[connectivity])
-    label = image.ravel()[flat].astype(np.int64) - 1
+    # ndimage numbers features in raster order of their first cell, so label - 1 is already
+    # the cluster index unless splitting adds pieces.
+    cluster = image.ravel()[flat].astype(np.int64) - 1
     if max_cells > 0:
-        label = _split_oversized(rows, cols, label, count, max_cells)
-    # Renumber in raster order of each cluster's first cell (cells are already in raster order).
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    cluster = rank[inverse.ravel()]
+        cluster = _split_oversized(rows, cols, cluster, count, max_cells)
     sizes = np.bincount(cluster)
-    centroids = np.stack(
-        [np.bincount(cluster, weights=rows), np.bincount(cluster, weights=cols)], axis=1
-    ) / sizes[:, None]
+    centroids = np.empty((len(sizes), 2))
+    centroids[:, 0] = np.bincount(cluster, weights=rows) / sizes
+    centroids[:, 1] = np.bincount(cluster, weights=cols) / sizes
     return Clusters(belief.shape, rows, cols, cluster, sizes, centroids)
 
 
 def _split_oversized(
     rows: np.ndarray, cols: np.ndarray, label: np.ndarray, count: int, max_cells: int
 ) -> np.ndarray:
+    """Split clusters above ``max_cells`` and renumber all pieces in raster order."""
     sizes = np.bincount(label, minlength=count)
     oversized = np.flatnonzero(sizes > max_cells)
     if oversized.size == 0:
         return label
     label = label.copy()
     next_label = count
-    for cluster in oversized:
+    for cluster in oversized.tolist():
         members = np.flatnonzero(label == cluster)
         for piece in split_cells(rows[members], cols[members], max_cells)[1:]:
             label[members[piece]] = next_label
             next_label += 1
-    return label
+    # Cells are in raster order, so a piece's first occurrence is its first cell.
+    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+    return rank[inverse.ravel()]
 
 
 def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.ndarray]:
@@ -127,21 +128,24 @@ def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.n
     """
     if max_cells < 1:
         raise ValueError(f"max_cells must be >= 1, got {max_cells}")
-    pieces: list[np.ndarray] = []
-    stack = [np.arange(len(rows))]
+    row_list, col_list = rows.tolist(), cols.tolist()
+    pieces: list[list[int]] = []
+    stack = [list(range(len(row_list)))]
     while stack:
         index = stack.pop()
         if len(index) <= max_cells:
             pieces.append(index)
             continue
-        r, c = rows[index], cols[index]
-        row_span, col_span = r.max() - r.min(), c.max() - c.min()
-        axis_values = r if row_span >= col_span else c
-        middle = (axis_values.min() + axis_values.max()) / 2.0
-        low = axis_values <= middle
-        stack.append(index[~low])
-        stack.append(index[low])
-    return sorted(pieces, key=lambda piece: int(piece.min()))
+        r = [row_list[i] for i in index]
+        c = [col_list[i] for i in index]
+        values = r if max(r) - min(r) >= max(c) - min(c) else c
+        middle = (min(values) + max(values)) / 2.0
+        low = [i for i, v in zip(index, values, strict=True) if v <= middle]
+        high = [i for i, v in zip(index, values, strict=True) if v > middle]
+        stack.append(high)
+        stack.append(low)
+    pieces.sort(key=min)
+    return [np.array(piece, dtype=np.int64) for piece in pieces]
 
 
 def unknown_around(belief: np.ndarray, clusters: Clusters) -> np.ndarray:
@@ -177,18 +181,27 @@ def nearest_cells_to_centroids(
     count = clusters.count
     targets = np.full((count, 2), -1, dtype=np.int64)
     has_target = np.zeros(count, dtype=bool)
-    pick = np.flatnonzero(eligible)
-    if pick.size == 0:
-        return has_target, targets
-    cluster = clusters.cell_cluster[pick]
-    rows, cols = clusters.cell_rows[pick], clusters.cell_cols[pick]
+    if eligible.all():
+        cluster, rows, cols = clusters.cell_cluster, clusters.cell_rows, clusters.cell_cols
+    else:
+        pick = np.flatnonzero(eligible)
+        if pick.size == 0:
+            return has_target, targets
+        cluster = clusters.cell_cluster[pick]
+        rows, cols = clusters.cell_rows[pick], clusters.cell_cols[pick]
     centroid = clusters.centroids[cluster]
     dist2 = (rows - centroid[:, 0]) ** 2 + (cols - centroid[:, 1]) ** 2
-    order = np.lexsort((pick, dist2, cluster))
-    first = order[np.r_[True, cluster[order][1:] != cluster[order][:-1]]]
-    has_target[cluster[first]] = True
-    targets[cluster[first], 0] = rows[first]
-    targets[cluster[first], 1] = cols[first]
+    # Stable sort by (cluster, distance): cells are in raster order, so ties keep raster order.
+    order = np.lexsort((dist2, cluster))
+    sorted_cluster = cluster[order]
+    starts = np.empty(len(order), dtype=bool)
+    starts[0] = True
+    np.not_equal(sorted_cluster[1:], sorted_cluster[:-1], out=starts[1:])
+    first = order[starts]
+    chosen = cluster[first]
+    has_target[chosen] = True
+    targets[chosen, 0] = rows[first]
+    targets[chosen, 1] = cols[first]
     return has_target, targets
 
 

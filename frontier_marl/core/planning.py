@@ -70,10 +70,10 @@ def _trace(parent: dict[int, int], target: int, width: int) -> np.ndarray:
     cells = []
     cell = target
     while cell != -1:
-        cells.append(cell)
+        cells.append(divmod(cell, width))
         cell = parent[cell]
-    flat = np.array(cells[::-1], dtype=np.int64)
-    return np.stack(np.divmod(flat, width), axis=1)
+    cells.reverse()
+    return np.array(cells, dtype=np.int64)
 
 
 def bfs_distances(passable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
@@ -96,8 +96,8 @@ def bfs_distances(passable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
             (row, col - 1, cell - 1),
             (row, col + 1, cell + 1),
         ):
-            if 0 <= n_row < height and 0 <= n_col < width and free[neighbour]:
-                if seen[neighbour] < 0:
-                    seen[neighbour] = d
-                    queue.append(neighbour)
+            inside = 0 <= n_row < height and 0 <= n_col < width
+            if inside and free[neighbour] and seen[neighbour] < 0:
+                seen[neighbour] = d
+                queue.append(neighbour)
     return np.array(seen, dtype=np.int64).reshape(height, width)

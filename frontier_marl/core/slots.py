@@ -50,26 +50,24 @@ def build_slots(
 ) -> SlotTable:
     """Select and order the slots of one robot at ``position`` (row, col)."""
     live = np.flatnonzero(has_target)
-    distance = np.hypot(centroids[live, 0] - position[0], centroids[live, 1] - position[1])
+    centroid_live = centroids[live]
+    distance = np.hypot(centroid_live[:, 0] - position[0], centroid_live[:, 1] - position[1])
     if len(live) > n_slots:
         keep = np.sort(np.argsort(distance, kind="stable")[:n_slots])
-        live, distance = live[keep], distance[keep]
-    if sort_by_distance:
+        live, distance, centroid_live = live[keep], distance[keep], centroid_live[keep]
+    if sort_by_distance and len(live) > 1:
         order = np.argsort(distance, kind="stable")
-        live, distance = live[order], distance[order]
+        live, distance, centroid_live = live[order], distance[order], centroid_live[order]
     k = len(live)
-    cluster = np.full(n_slots, -1, dtype=np.int64)
-    cluster[:k] = live
+    pad = n_slots - k
     valid = np.zeros(n_slots, dtype=bool)
     valid[:k] = True
-    centroid = np.zeros((n_slots, 2))
-    centroid[:k] = centroids[live]
-    target = np.full((n_slots, 2), -1, dtype=np.int64)
-    target[:k] = targets[live]
-    dist = np.zeros(n_slots)
-    dist[:k] = distance
-    size = np.zeros(n_slots, dtype=np.int64)
-    size[:k] = sizes[live]
-    gain = np.zeros(n_slots)
-    gain[:k] = gains[live]
-    return SlotTable(cluster, valid, centroid, target, dist, size, gain)
+    return SlotTable(
+        cluster=np.concatenate([live, np.full(pad, -1, dtype=np.int64)]),
+        valid=valid,
+        centroid=np.concatenate([centroid_live, np.zeros((pad, 2))]),
+        target=np.concatenate([targets[live], np.full((pad, 2), -1, dtype=np.int64)]),
+        distance=np.concatenate([distance, np.zeros(pad)]),
+        size=np.concatenate([sizes[live], np.zeros(pad, dtype=np.int64)]),
+        gain=np.concatenate([gains[live], np.zeros(pad)]),
+    )

@@ -84,7 +84,11 @@ class World:
         self._passable_version = -1
         self._passable = np.zeros_like(true_grid)
         self._start_region = _reachable_region(true_grid, starts)
+        self._start_region_size = int(np.count_nonzero(self._start_region))
         self._true_free_count = int(np.count_nonzero(~true_grid))
+        self._fractions: dict[str, float] = {}
+        self._fraction_version = -1
+        self._targets: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for agent in range(len(starts)):
             self._sense(agent)
 
@@ -126,14 +130,24 @@ class World:
 
     def explored_fraction(self, basis: str) -> float:
         """Fraction of ``all`` cells known, of true-``free`` cells known free, or of the
-        ``reachable`` free region known."""
+        ``reachable`` free region known (cached until the belief changes)."""
+        if self._fraction_version != self._version:
+            self._fractions.clear()
+            self._fraction_version = self._version
+        fraction = self._fractions.get(basis)
+        if fraction is None:
+            fraction = self._fractions[basis] = self._compute_fraction(basis)
+        return fraction
+
+    def _compute_fraction(self, basis: str) -> float:
+        belief = self._belief
         if basis == "all":
-            return float(np.count_nonzero(self._belief != UNKNOWN)) / self._belief.size
+            return float(np.count_nonzero(belief != UNKNOWN)) / belief.size
         if basis == "free":
-            return float(np.count_nonzero(self._belief == FREE)) / max(self._true_free_count, 1)
+            return float(np.count_nonzero(belief == FREE)) / max(self._true_free_count, 1)
         if basis == "reachable":
-            known = np.count_nonzero(self._belief[self._start_region] != UNKNOWN)
-            return float(known) / max(int(np.count_nonzero(self._start_region)), 1)
+            known = np.count_nonzero(belief[self._start_region] != UNKNOWN)
+            return float(known) / max(self._start_region_size, 1)
         raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
 
     # ----------------------------------------------------------------- frontier view
@@ -148,8 +162,12 @@ class World:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""
         clusters, gains, components, cell_component = self._frontier_cache()
         row, col = self._positions[agent]
-        eligible = cell_component == components[row, col]
-        has_target, targets = nearest_cells_to_centroids(clusters, eligible)
+        component = int(components[row, col])
+        found = self._targets.get(component)
+        if found is None:
+            found = nearest_cells_to_centroids(clusters, cell_component == component)
+            self._targets[component] = found
+        has_target, targets = found
         return build_slots(
             self._positions[agent],
             clusters.centroids,
@@ -172,6 +190,7 @@ class World:
             components = free_components(self._belief)
             cell_component = components[clusters.cell_rows, clusters.cell_cols]
             self._cache = (clusters, gains, components, cell_component)
+            self._targets = {}
             self._cache_version = self._version
         return self._cache
 

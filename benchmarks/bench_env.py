@@ -1,0 +1,137 @@
+"""Speed benchmark of the simulator (issue 2, item 10). Not a test: run it by hand.
+
+    python benchmarks/bench_env.py                 # everything, ~3 minutes on 2 cores
+    python benchmarks/bench_env.py --skip-dqn      # decisions per second only
+    python benchmarks/bench_env.py --json out.json
+
+Reports decisions per second (one decision = one ``step`` of all robots) for a random-valid-slot
+policy and a nearest-cluster policy on the thesis presets and larger maps, and the share of SB3
+DQN training wall time spent in the env: the same DQN trains for the same number of steps on the
+env and on a null env with identical spaces, in one run, and
+
+    env share = (T_env - T_null) / T_env.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from typing import Any
+
+import numpy as np
+
+import frontier_marl
+
+SETTINGS: list[tuple[str, dict[str, Any]]] = [
+    ("thesis-20x20, 1 robot", {"preset": "thesis-20x20"}),
+    ("thesis-30x30, 1 robot", {"preset": "thesis-30x30"}),
+    ("64x64, 4 robots", {"preset": "thesis-20x20", "height": 64, "width": 64, "n_agents": 4,
+                         "max_steps": 2000}),
+    ("128x128, 8 robots", {"preset": "thesis-20x20", "height": 128, "width": 128, "n_agents": 8,
+                           "max_steps": 4000, "perception_range": 5}),
+]
+
+
+def nearest(info: dict[str, Any], rng: np.random.Generator) -> int:
+    clusters = info["clusters"]
+    return min(clusters, key=lambda c: c["distance"])["slot"] if clusters else 0
+
+
+def random_valid(info: dict[str, Any], rng: np.random.Generator) -> int:
+    return int(rng.choice(np.flatnonzero(info["action_mask"])))
+
+
+def decisions_per_second(kwargs: dict[str, Any], policy: Any, seconds: float) -> dict[str, float]:
+    """Play whole episodes for about ``seconds``; time only ``reset`` and ``step``."""
+    env = frontier_marl.parallel_env(**kwargs)
+    rng = np.random.default_rng(0)
+    env_time, steps, episodes, seed = 0.0, 0, 0, 0
+    while env_time < seconds:
+        start = time.perf_counter()
+        _, infos = env.reset(seed=seed)
+        env_time += time.perf_counter() - start
+        seed += 1
+        while env.agents:
+            actions = {agent: policy(infos[agent], rng) for agent in env.agents}
+            start = time.perf_counter()
+            _, _, _, _, infos = env.step(actions)
+            env_time += time.perf_counter() - start
+            steps += 1
+        episodes += 1
+    return {"decisions_per_s": steps / env_time, "us_per_decision": 1e6 * env_time / steps,
+            "steps": steps, "episodes": episodes}
+
+
+def dqn_env_share(steps: int) -> dict[str, float]:
+    """Train the thesis's DQN on the env and on a null env with the same spaces."""
+    import gymnasium as gym
+    import torch
+    from stable_baselines3 import DQN
+
+    torch.set_num_threads(1)
+    real = frontier_marl.FrontierExploreEnv(preset="thesis-20x20")
+
+    class NullEnv(gym.Env):
+        """Same spaces, constant observation, 100-step episodes, no simulation."""
+
+        def __init__(self) -> None:
+            self.observation_space = real.observation_space
+            self.action_space = real.action_space
+            self._obs = self.observation_space.sample()
+            self._t = 0
+
+        def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+            super().reset(seed=seed)
+            self._t = 0
+            return self._obs, {}
+
+        def step(self, action: Any) -> Any:
+            self._t += 1
+            return self._obs, 0.0, False, self._t >= 100, {}
+
+    timings = {}
+    for name, env in (("null", NullEnv()), ("env", real)):
+        model = DQN(
+            "MultiInputPolicy", env, learning_rate=5e-5, exploration_fraction=0.7,
+            exploration_final_eps=0.05, batch_size=64, buffer_size=50_000,
+            target_update_interval=500, train_freq=4, learning_starts=1000, seed=0, verbose=0,
+        )
+        start = time.perf_counter()
+        model.learn(total_timesteps=steps)
+        timings[name] = time.perf_counter() - start
+    share = (timings["env"] - timings["null"]) / timings["env"]
+    return {"steps": steps, "seconds_null": timings["null"], "seconds_env": timings["env"],
+            "steps_per_s_env": steps / timings["env"], "env_share": share}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=8.0, help="timed seconds per setting")
+    parser.add_argument("--dqn-steps", type=int, default=30_000)
+    parser.add_argument("--skip-dqn", action="store_true")
+    parser.add_argument("--json", help="write the figures to this file")
+    args = parser.parse_args()
+    report: dict[str, Any] = {"machine": platform.processor() or platform.machine(),
+                              "python": platform.python_version(), "decisions": []}
+    print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
+    for label, kwargs in SETTINGS:
+        for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
+            row = decisions_per_second(kwargs, policy, args.seconds)
+            report["decisions"].append({"setting": label, "policy": policy_name, **row})
+            print(f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
+                  f"{row['us_per_decision']:>13.1f}")
+    if not args.skip_dqn:
+        dqn = dqn_env_share(args.dqn_steps)
+        report["dqn"] = dqn
+        print(f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
+              f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
+              f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} %")
+    if args.json:
+        with open(args.json, "w") as handle:
+            json.dump(report, handle, indent=2)
+
+
+if __name__ == "__main__":
+    main()
