@@ -18,6 +18,7 @@ import argparse
 import json
 import platform
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -32,6 +33,25 @@ SETTINGS: list[tuple[str, dict[str, Any]]] = [
     ("128x128, 8 robots", {"preset": "thesis-20x20", "height": 128, "width": 128, "n_agents": 8,
                            "max_steps": 4000, "perception_range": 5}),
 ]
+
+
+SHARED_MAPS = Path(__file__).resolve().parents[2] / "shared/maps/explore-bench"
+EXPLORE_BENCH_MAP = SHARED_MAPS / "room1_modified.pgm"
+
+
+def explore_bench_settings(map_file: Path) -> list[tuple[str, dict[str, Any]]]:
+    """Explore-Bench's room1_modified map with its classical sensor range (35 cells).
+
+    Explore-Bench's own Python simulator reached ~12 steps/s (nearest frontier, one cell per
+    step) and ~2.7 steps/s (learning env, one goal per step, moved all the way) on this map and
+    machine kind (figures from shared/maps/explore-bench/README.md).
+    """
+    common = {"map_path": str(map_file), "perception_range": 35, "max_steps": 100_000,
+              "no_progress_limit": 10_000}
+    return [
+        ("room1_modified, 1 cell", {**common, "cells_per_step": 1}),
+        ("room1_modified, full", {**common, "cells_per_step": "full"}),
+    ]
 
 
 def nearest(info: dict[str, Any], rng: np.random.Generator) -> int:
@@ -112,11 +132,17 @@ def main() -> None:
     parser.add_argument("--dqn-steps", type=int, default=30_000)
     parser.add_argument("--skip-dqn", action="store_true")
     parser.add_argument("--json", help="write the figures to this file")
+    parser.add_argument("--explore-bench-map", type=Path, default=EXPLORE_BENCH_MAP,
+                        help="Explore-Bench PGM map for the side-by-side figure "
+                        "(skipped if absent)")
     args = parser.parse_args()
+    settings = list(SETTINGS)
+    if args.explore_bench_map.is_file():
+        settings += explore_bench_settings(args.explore_bench_map)
     report: dict[str, Any] = {"machine": platform.processor() or platform.machine(),
                               "python": platform.python_version(), "decisions": []}
     print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
-    for label, kwargs in SETTINGS:
+    for label, kwargs in settings:
         for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
             row = decisions_per_second(kwargs, policy, args.seconds)
             report["decisions"].append({"setting": label, "policy": policy_name, **row})

@@ -146,6 +146,8 @@ class EnvConfig:
         obstacle_prob: probability that a cell is an obstacle (open choice).
         map_mode: ``static`` (one layout from ``map_seed``) or ``dynamic`` (new layout per reset).
         map_seed: seed of the static layout, recorded so results are comparable across runs.
+        map_path: load the (static) layout from a .txt, .pgm or .png file instead of drawing
+            it; the file sets ``height`` and ``width``.
         perception_range: sensor range r in cells.
         sensor: ``square`` (Chebyshev window, no occlusion) or ``raycast`` (Euclidean disc with
             line of sight through free cells). Open choice.
@@ -165,6 +167,7 @@ class EnvConfig:
     obstacle_prob: float = 0.2
     map_mode: MapMode = "static"
     map_seed: int = 0
+    map_path: str | None = None
     perception_range: int = 3
     sensor: SensorModel = "square"
     cells_per_step: int | str = 1
@@ -186,6 +189,13 @@ class EnvConfig:
         _check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
         _check_choice("map_mode", self.map_mode, _MAP_MODES)
         _check_int("map_seed", self.map_seed, 0)
+        if self.map_path is not None:
+            if not isinstance(self.map_path, str):
+                raise ValueError(f"map_path must be a file path string, got {self.map_path!r}")
+            if self.map_mode != "static":
+                raise ValueError(
+                    "map_mode must be 'static' with map_path (a file holds one fixed layout)"
+                )
         _check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
         _check_choice("sensor", self.sensor, _SENSORS)
         if self.cells_per_step != FULL_PATH:
@@ -262,6 +272,9 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
             f"unknown parameter(s) {sorted(unknown)}; allowed: {', '.join(config_keys())}"
         )
     env_kw = {k: v for k, v in overrides.items() if k in _ENV_KEYS}
+    if env_kw.get("map_path") is not None:
+        env_kw["map_path"] = str(env_kw["map_path"])
+        env_kw.update(_shape_from_map_file(env_kw["map_path"], env_kw))
     obs_kw = {k: v for k, v in overrides.items() if k in _OBS_KEYS}
     rew_kw = {k: v for k, v in overrides.items() if k in _REWARD_KEYS}
     observation = overrides.get("observation", cfg.observation)
@@ -278,6 +291,16 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
     if isinstance(reward, RewardConfig) and rew_kw:
         reward = dataclasses.replace(reward, **rew_kw)
     return dataclasses.replace(cfg, observation=observation, reward=reward, **env_kw)
+
+
+def _shape_from_map_file(path: str, overrides: dict[str, Any]) -> dict[str, int]:
+    from frontier_marl.core.map_files import load_map
+
+    height, width = load_map(path).shape
+    for name, size in (("height", height), ("width", width)):
+        if name in overrides and overrides[name] != size:
+            raise ValueError(f"{name}={overrides[name]} contradicts map_path {path} ({name} {size})")
+    return {"height": height, "width": width}
 
 
 def config_to_dict(cfg: EnvConfig) -> dict[str, Any]:

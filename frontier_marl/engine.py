@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.core.map_files import load_map
 from frontier_marl.core.maps import largest_free_component, random_obstacle_map, sample_start_cells
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.slots import SlotTable
@@ -59,8 +60,13 @@ class ExplorationMDP:
 
     # ------------------------------------------------------------------ episode
     def true_grid_for_episode(self, rng: np.random.Generator) -> np.ndarray:
-        """The static layout (from ``map_seed``) or a fresh dynamic one (from ``rng``)."""
+        """The layout from ``map_path``, the static one (from ``map_seed``), or a fresh dynamic
+        one (from ``rng``)."""
         cfg = self.cfg
+        if cfg.map_path is not None:
+            if self._static_map is None:
+                self._static_map = load_map(cfg.map_path)
+            return self._static_map
         if cfg.map_mode == "static":
             if self._static_map is None:
                 map_rng = np.random.default_rng(cfg.map_seed)
