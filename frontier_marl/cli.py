@@ -12,6 +12,7 @@ from collections.abc import Sequence
 #: subcommand -> (module under frontier_marl.commands, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "gif": ("gif", "run one episode with a heuristic and write it as a GIF"),
+    "baselines": ("baselines", "evaluate the heuristic baselines with the thesis's protocol"),
 }
 
 

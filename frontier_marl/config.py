@@ -299,7 +299,9 @@ def _shape_from_map_file(path: str, overrides: dict[str, Any]) -> dict[str, int]
     height, width = load_map(path).shape
     for name, size in (("height", height), ("width", width)):
         if name in overrides and overrides[name] != size:
-            raise ValueError(f"{name}={overrides[name]} contradicts map_path {path} ({name} {size})")
+            raise ValueError(
+                f"{name}={overrides[name]} contradicts map_path {path} ({name} {size})"
+            )
     return {"height": height, "width": width}
 
 
