@@ -13,6 +13,7 @@ lists them with the reason for each default.
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -200,7 +201,8 @@ class EnvConfig:
         _check_choice("sensor", self.sensor, _SENSORS)
         if self.cells_per_step != FULL_PATH:
             _check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
-        if self.connectivity not in (4, 8) or isinstance(self.connectivity, bool):
+        _check_int("connectivity", self.connectivity, 4, 8)
+        if self.connectivity not in (4, 8):
             raise ValueError(f"connectivity must be 4 or 8, got {self.connectivity!r}")
         _check_int("max_cluster_cells", self.max_cluster_cells, 1)
         _check_int("n_slots", self.n_slots, 1, 256)
@@ -273,7 +275,10 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
         )
     env_kw = {k: v for k, v in overrides.items() if k in _ENV_KEYS}
     if env_kw.get("map_path") is not None:
-        env_kw["map_path"] = str(env_kw["map_path"])
+        if isinstance(env_kw["map_path"], os.PathLike):
+            env_kw["map_path"] = os.fspath(env_kw["map_path"])
+        if not isinstance(env_kw["map_path"], str):
+            raise ValueError(f"map_path must be a file path, got {env_kw['map_path']!r}")
         env_kw.update(_shape_from_map_file(env_kw["map_path"], env_kw))
     obs_kw = {k: v for k, v in overrides.items() if k in _OBS_KEYS}
     rew_kw = {k: v for k, v in overrides.items() if k in _REWARD_KEYS}
@@ -296,7 +301,10 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
 def _shape_from_map_file(path: str, overrides: dict[str, Any]) -> dict[str, int]:
     from frontier_marl.core.map_files import load_map
 
-    height, width = load_map(path).shape
+    try:
+        height, width = load_map(path).shape
+    except ValueError as error:
+        raise ValueError(f"map_path: {error}") from error
     for name, size in (("height", height), ("width", width)):
         if name in overrides and overrides[name] != size:
             raise ValueError(

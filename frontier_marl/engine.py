@@ -179,13 +179,7 @@ class ExplorationMDP:
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
-        masks = []
-        for table in self._slots:
-            mask = table.valid.astype(np.int8)
-            if table.live == 0:
-                mask[0] = 1
-            masks.append(mask)
-        return masks
+        return [table.action_mask() for table in self._slots]
 
     def _observations(self) -> list[Observation]:
         assert self.world is not None

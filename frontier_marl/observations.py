@@ -8,8 +8,8 @@ Layout (the thesis's Table 4.1 axes, see :class:`~frontier_marl.config.Observati
   Padding slots are all zeros.
 * Without the agent position (and without ``action_mask``) the observation *is* that vector
   (a ``Box``, for SB3's ``MlpPolicy``). Otherwise it is a ``Dict`` with keys ``clusters``,
-  ``agent_position`` (row, col) when enabled, and ``action_mask`` (int8, 1 = valid slot) when
-  enabled (for SB3's ``MultiInputPolicy``).
+  ``agent_position`` (row, col) when enabled, and ``action_mask`` (int8, 1 = live slot; slot 0
+  alone when no cluster is live, the robot then idles) when enabled (for SB3's ``MultiInputPolicy``).
 * With ``normalize``, rows are divided by the height, columns by the width, distances by the
   diagonal and gains by their upper bound, so every value lies in [-1, 1].
 """
@@ -102,7 +102,7 @@ class ObservationEncoder:
         if self.agent_position:
             out["agent_position"] = (position / self._position_scale).astype(np.float32)
         if self.action_mask:
-            out["action_mask"] = slots.valid.astype(np.int8)
+            out["action_mask"] = slots.action_mask()
         return out
 
 

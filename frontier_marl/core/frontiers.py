@@ -181,6 +181,8 @@ def nearest_cells_to_centroids(
     count = clusters.count
     targets = np.full((count, 2), -1, dtype=np.int64)
     has_target = np.zeros(count, dtype=bool)
+    if count == 0:
+        return has_target, targets
     if eligible.all():
         cluster, rows, cols = clusters.cell_cluster, clusters.cell_rows, clusters.cell_cols
     else:

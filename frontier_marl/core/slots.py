@@ -37,6 +37,13 @@ class SlotTable:
         """How many slots hold a cluster."""
         return int(self.valid.sum())
 
+    def action_mask(self) -> np.ndarray:
+        """int8 mask of the actions worth taking: the live slots, or slot 0 (idle) if none."""
+        mask = self.valid.astype(np.int8)
+        if not mask.any():
+            mask[0] = 1
+        return mask
+
 
 def build_slots(
     position: np.ndarray,

@@ -1,0 +1,120 @@
+"""``frontier-marl gif``: run one episode with a heuristic and write it as a GIF.
+
+Example::
+
+    frontier-marl gif --policy greedy-distance --preset thesis-20x20 --seed 0 --out episode.gif
+
+The frames show the true grid beside the robots' belief, the frontier clusters and their
+centroids, the robots, their last paths and targets (see :mod:`frontier_marl.render`).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.commands.baselines import (
+    add_env_arguments,
+    env_kwargs_from_args,
+    fail,
+    positive_int,
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from frontier_marl.policies import POLICIES
+
+    parser.add_argument("--policy", choices=list(POLICIES), default="greedy-distance",
+                        help="heuristic driving the robots (default: %(default)s)")
+    add_env_arguments(parser)
+    parser.add_argument("--out", type=Path, default=Path("episode.gif"),
+                        help="GIF file to write (default: %(default)s)")
+    parser.add_argument("--fps", type=float, default=4.0,
+                        help="frames per second (default: %(default)s)")
+    parser.add_argument("--cell-px", type=positive_int, default=12,
+                        help="pixels per grid cell (default: %(default)s)")
+    parser.add_argument("--max-steps", type=positive_int, default=None,
+                        help="stop after this many decisions (default: when the episode ends)")
+
+
+def render_frame(env: Any, infos: dict[str, dict[str, Any]], cell_px: int) -> np.ndarray:
+    """An RGB frame of ``env``'s current state at ``cell_px`` pixels per cell (the same
+    picture as ``env.render()`` in ``rgb_array`` mode, which is fixed at 12 px)."""
+    from frontier_marl.render import render_rgb
+
+    world = env.unwrapped.world
+    clusters = world.clusters()
+    targets = np.full((world.n_agents, 2), -1, dtype=np.int64)
+    paths = []
+    for agent, info in enumerate(infos.values()):
+        paths.append(info["path"])
+        if info.get("target") is not None:
+            targets[agent] = info["target"]
+    return render_rgb(
+        world.true_grid,
+        world.belief,
+        world.positions,
+        cluster_labels=clusters.labels(),
+        centroids=clusters.centroids,
+        paths=paths,
+        targets=targets,
+        cell_px=cell_px,
+    )
+
+
+def record_episode(
+    env_kwargs: dict[str, Any],
+    policy_name: str,
+    seed: int,
+    cell_px: int = 12,
+    max_steps: int | None = None,
+) -> tuple[list[np.ndarray], float, int, str]:
+    """Frames (reset included), team-mean return, decision steps and end reason."""
+    import frontier_marl
+    from frontier_marl.policies import make_policy
+
+    env = frontier_marl.parallel_env(render_mode="rgb_array", **env_kwargs)
+    try:
+        policy = make_policy(policy_name, seed)
+        policy.attach(env)
+        observations, infos = env.reset(seed=seed)
+        frames = [render_frame(env, infos, cell_px)]
+        returns = dict.fromkeys(env.agents, 0.0)
+        steps = 0
+        reason = ""
+        while env.agents and (max_steps is None or steps < max_steps):
+            actions = policy.act_team(observations, infos)
+            observations, rewards, _, _, infos = env.step(actions)
+            for agent, reward in rewards.items():
+                returns[agent] += reward
+            steps += 1
+            frames.append(render_frame(env, infos, cell_px))
+            reason = next(iter(infos.values()))["end_reason"]
+        if env.agents:
+            reason = "max_steps"
+    finally:
+        env.close()
+    return frames, float(np.mean(list(returns.values()))), steps, reason
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        env_kwargs = env_kwargs_from_args(args)
+        if not args.fps > 0:
+            raise ValueError(f"--fps must be > 0, got {args.fps}")
+    except ValueError as exc:
+        return fail("gif", str(exc))
+    from frontier_marl.render import write_gif
+
+    frames, reward, steps, reason = record_episode(
+        env_kwargs, args.policy, args.seed, args.cell_px, args.max_steps
+    )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    write_gif(frames, args.out, fps=args.fps)
+    print(f"wrote {args.out}")
+    print(f"policy {args.policy}, seed {args.seed}: reward {reward:.2f}, {steps} steps, "
+          f"end: {reason or 'none'}")
+    return 0

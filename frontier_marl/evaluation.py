@@ -1,0 +1,385 @@
+"""The thesis's evaluation protocol as a library function.
+
+:func:`evaluate` runs a policy for ``episodes`` episodes; episode ``i`` resets the env with seed
+``seed + i`` (and the policy with the same seed). On a static map every episode shares the
+layout drawn from the config's ``map_seed`` (recorded in the result) and only the start cell
+changes; on dynamic maps each seed also draws a fresh layout. Reported, as in SPEC section 5:
+
+* total episode reward: mean and *population* standard deviation (numpy's default, the same as
+  SB3's ``evaluate_policy``). With a team, an episode's reward is the mean over robots of each
+  robot's return (the sum of its rewards over the episode); per-robot returns are kept too;
+* terminations: episodes that ended by reaching the exploration threshold
+  (``end_reason == "threshold"``), plus a count of every end reason;
+* the action histogram: the share of each slot among all decisions of all robots;
+* decision steps and cells travelled (the team's sum of ``travelled``) per episode;
+* cells travelled when coverage of the reachable free region (info ``coverage``) first reaches
+  each level of ``coverage_levels`` (default 0.90 and 0.99), with how many episodes got there;
+* a coverage-versus-cells-travelled curve per episode (see :mod:`frontier_marl.metrics`).
+
+The env may be a dict of keyword arguments for :func:`frontier_marl.parallel_env`, a
+zero-argument factory, or an env instance: a PettingZoo ``ParallelEnv`` or a single-robot
+Gymnasium env (possibly wrapped, e.g. for a learned model). The policy is anything with the
+:class:`~frontier_marl.policies.Policy` interface; wrap a plain ``obs -> action`` callable or an
+SB3 model with :class:`~frontier_marl.policies.CallablePolicy` /
+:class:`~frontier_marl.policies.ModelPolicy`.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections import Counter
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.metrics import action_shares, cells_to_coverage, coverage_curve, mean_std
+from frontier_marl.policies import Policy
+
+#: The thesis's heuristic baselines (SPEC section 6): (preset, map mode, policy) -> (mean, std)
+#: of the total episode reward over 30 episodes, one robot.
+THESIS_FIGURES: dict[tuple[str, str, str], tuple[float, float]] = {
+    ("thesis-20x20", "static", "greedy-distance"): (16.48, 1.78),
+    ("thesis-20x20", "static", "greedy-gain"): (15.01, 1.12),
+}
+
+DEFAULT_LEVELS: tuple[float, ...] = (0.90, 0.99)
+
+
+def thesis_figure(preset: str, map_mode: str, policy: str) -> tuple[float, float] | None:
+    """The thesis's (mean, std) for this setting, or ``None`` where SPEC gives none."""
+    return THESIS_FIGURES.get((preset, map_mode, policy))
+
+
+def level_key(level: float) -> str:
+    """The JSON key of a coverage level, e.g. ``0.9 -> "0.90"``."""
+    return f"{level:.2f}"
+
+
+@dataclass
+class EpisodeRecord:
+    """What one evaluation episode produced."""
+
+    seed: int
+    reward: float  # team mean of the robots' returns (= the return with one robot)
+    robot_rewards: list[float]
+    steps: int
+    end_reason: str
+    travelled: int  # team total
+    coverage: float  # final coverage of the reachable free region
+    explored_fraction: float  # final explored fraction (the threshold's basis)
+    action_counts: list[int]
+    cells_to_coverage: dict[str, float | None]  # level_key -> cells travelled, None = never
+    curve: np.ndarray  # (L, 2) cells travelled, coverage
+
+    @property
+    def reached_threshold(self) -> bool:
+        return self.end_reason == "threshold"
+
+    def to_dict(self, curve: bool = True) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "seed": self.seed,
+            "reward": self.reward,
+            "robot_rewards": list(self.robot_rewards),
+            "steps": self.steps,
+            "end_reason": self.end_reason,
+            "travelled": self.travelled,
+            "coverage": self.coverage,
+            "explored_fraction": self.explored_fraction,
+            "action_counts": list(self.action_counts),
+            "cells_to_coverage": dict(self.cells_to_coverage),
+        }
+        if curve:
+            out["curve"] = [[int(t), round(float(c), 6)] for t, c in self.curve]
+        return out
+
+
+@dataclass
+class EvaluationResult:
+    """Per-episode records and the protocol's summary statistics."""
+
+    policy: str
+    seed: int
+    n_slots: int
+    n_agents: int
+    coverage_levels: tuple[float, ...]
+    episodes: list[EpisodeRecord]
+    config: dict[str, Any] | None = None
+    map_mode: str | None = None
+    map_seed: int | None = None  # the static layout's seed; None for dynamic maps
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def rewards(self) -> list[float]:
+        return [e.reward for e in self.episodes]
+
+    @property
+    def mean_reward(self) -> float:
+        return mean_std(self.rewards)[0]
+
+    @property
+    def std_reward(self) -> float:
+        return mean_std(self.rewards)[1]
+
+    @property
+    def terminations(self) -> int:
+        """Episodes that ended by reaching the exploration threshold."""
+        return sum(e.reached_threshold for e in self.episodes)
+
+    @property
+    def end_reasons(self) -> dict[str, int]:
+        return dict(sorted(Counter(e.end_reason for e in self.episodes).items()))
+
+    @property
+    def action_counts(self) -> list[int]:
+        counts = np.zeros(self.n_slots, dtype=np.int64)
+        for e in self.episodes:
+            counts += np.asarray(e.action_counts, dtype=np.int64)
+        return counts.tolist()
+
+    @property
+    def action_shares(self) -> list[float]:
+        return action_shares(self.action_counts)
+
+    def stat(self, name: str) -> tuple[float, float]:
+        """Mean and population std of a per-episode number (``steps``, ``travelled``...)."""
+        return mean_std([getattr(e, name) for e in self.episodes])
+
+    def cells_to(self, level: float) -> dict[str, Any]:
+        """Cells travelled to reach ``level``: episodes that got there, mean/std over those."""
+        key = level_key(level)
+        values = [e.cells_to_coverage.get(key) for e in self.episodes]
+        reached = [v for v in values if v is not None]
+        mean, std = mean_std(reached)
+        return {
+            "level": level,
+            "reached": len(reached),
+            "mean": None if not reached else mean,
+            "std": None if not reached else std,
+            "per_episode": values,
+        }
+
+    def to_dict(self, curves: bool = True) -> dict[str, Any]:
+        """A JSON-able summary row plus the per-episode records (with curves if asked)."""
+        steps_mean, steps_std = self.stat("steps")
+        travelled_mean, travelled_std = self.stat("travelled")
+        coverage_mean, _ = self.stat("coverage")
+        return {
+            "policy": self.policy,
+            "episodes": len(self.episodes),
+            "seed": self.seed,
+            "seeds": [e.seed for e in self.episodes],
+            "n_agents": self.n_agents,
+            "n_slots": self.n_slots,
+            "map_mode": self.map_mode,
+            "map_seed": self.map_seed,
+            "mean_reward": self.mean_reward,
+            "std_reward": self.std_reward,
+            "rewards": self.rewards,
+            "terminations": self.terminations,
+            "end_reasons": self.end_reasons,
+            "action_counts": self.action_counts,
+            "action_shares": self.action_shares,
+            "mean_steps": steps_mean,
+            "std_steps": steps_std,
+            "mean_travelled": travelled_mean,
+            "std_travelled": travelled_std,
+            "mean_final_coverage": coverage_mean,
+            "cells_to_coverage": {
+                level_key(level): self.cells_to(level) for level in self.coverage_levels
+            },
+            "config": self.config,
+            **self.extra,
+            "per_episode": [e.to_dict(curve=curves) for e in self.episodes],
+        }
+
+
+# --------------------------------------------------------------------------- env adapters
+
+
+class _TeamView:
+    """Runs a ParallelEnv or a single-robot Gymnasium env through one dict-based interface."""
+
+    def __init__(self, env: Any) -> None:
+        import gymnasium as gym
+
+        self.env = env
+        self.single = isinstance(env, gym.Env)
+        if self.single:
+            self.agents = ["robot_0"]
+            self.n_slots = int(env.action_space.n)
+        else:
+            self.agents = list(env.possible_agents)
+            self.n_slots = int(env.action_space(self.agents[0]).n)
+
+    def reset(self, seed: int) -> tuple[dict[str, Any], dict[str, Any]]:
+        if self.single:
+            obs, info = self.env.reset(seed=seed)
+            return {"robot_0": obs}, {"robot_0": info}
+        return self.env.reset(seed=seed)
+
+    def step(self, actions: dict[str, int]) -> tuple[dict, dict, bool, dict]:
+        """Returns observations, rewards, done, infos."""
+        if self.single:
+            obs, reward, terminated, truncated, info = self.env.step(actions["robot_0"])
+            return (
+                {"robot_0": obs},
+                {"robot_0": float(reward)},
+                bool(terminated or truncated),
+                {"robot_0": info},
+            )
+        obs, rewards, terminations, truncations, infos = self.env.step(actions)
+        done = all(terminations[a] or truncations[a] for a in rewards) or not self.env.agents
+        return obs, rewards, done, infos
+
+
+def _config_of(env: Any) -> Any:
+    for candidate in (env, getattr(env, "unwrapped", None)):
+        config = getattr(candidate, "config", None)
+        if config is not None:
+            return config
+    return None
+
+
+EnvSpec = Mapping[str, Any] | Callable[[], Any] | Any
+
+
+def _build_env(env: EnvSpec) -> tuple[Any, bool]:
+    """The env to run and whether this module created it (and so must close it)."""
+    if isinstance(env, Mapping):
+        import frontier_marl
+
+        return frontier_marl.parallel_env(**dict(env)), True
+    if isinstance(env, type) or (callable(env) and not hasattr(env, "reset")):
+        return env(), True
+    return env, False
+
+
+# --------------------------------------------------------------------------- protocol
+
+
+def run_episode(
+    view: _TeamView,
+    policy: Policy,
+    seed: int,
+    coverage_levels: Sequence[float] = DEFAULT_LEVELS,
+    max_steps: int | None = None,
+) -> EpisodeRecord:
+    """One episode of ``policy`` from reset seed ``seed``."""
+    policy.reset(seed)
+    observations, infos = view.reset(seed)
+    agents = list(observations)
+    returns = dict.fromkeys(agents, 0.0)
+    counts = np.zeros(view.n_slots, dtype=np.int64)
+    travelled = [sum(int(infos[a]["travelled"]) for a in agents)]
+    coverage = [float(infos[agents[0]]["coverage"])]
+    steps = 0
+    done = False
+    while not done and (max_steps is None or steps < max_steps):
+        actions = policy.act_team(observations, infos)
+        for agent in agents:
+            slot = int(actions[agent])
+            if 0 <= slot < view.n_slots:
+                counts[slot] += 1
+        observations, rewards, done, infos = view.step(actions)
+        for agent in agents:
+            returns[agent] += float(rewards[agent])
+        steps += 1
+        travelled.append(sum(int(infos[a]["travelled"]) for a in agents))
+        coverage.append(float(infos[agents[0]]["coverage"]))
+    last = infos[agents[0]]
+    curve = coverage_curve(travelled, coverage)
+    robot_rewards = [returns[a] for a in agents]
+    return EpisodeRecord(
+        seed=seed,
+        reward=float(np.mean(robot_rewards)),
+        robot_rewards=robot_rewards,
+        steps=steps,
+        end_reason=str(last.get("end_reason", "")) if done else "max_steps",
+        travelled=travelled[-1],
+        coverage=coverage[-1],
+        explored_fraction=float(last.get("explored_fraction", float("nan"))),
+        action_counts=counts.tolist(),
+        cells_to_coverage={
+            level_key(level): cells_to_coverage(curve, level) for level in coverage_levels
+        },
+        curve=curve,
+    )
+
+
+def evaluate(
+    env: EnvSpec,
+    policy: Policy,
+    episodes: int = 30,
+    seed: int = 0,
+    *,
+    map_mode: str | None = None,
+    coverage_levels: Sequence[float] = DEFAULT_LEVELS,
+    max_steps: int | None = None,
+    on_episode: Callable[[int, EpisodeRecord], None] | None = None,
+) -> EvaluationResult:
+    """Run the evaluation protocol (see the module docstring).
+
+    Args:
+        env: kwargs for :func:`frontier_marl.parallel_env` (e.g. ``{"preset": "thesis-20x20",
+            "map_mode": "static"}``), a zero-argument env factory, or an env instance.
+        policy: a :class:`~frontier_marl.policies.Policy`; it is attached to the env once and
+            reset with each episode's seed.
+        episodes: number of episodes (>= 1).
+        seed: episode ``i`` uses reset seed ``seed + i``.
+        map_mode: ``static`` or ``dynamic``, merged into ``env`` when it is a kwargs dict.
+        coverage_levels: coverage levels for the cells-travelled metric, each in (0, 1].
+        max_steps: optional cap on decision steps per episode (end reason ``max_steps``);
+            ``None`` runs until the env ends the episode.
+        on_episode: called with ``(i, record)`` after each episode (e.g. a progress bar).
+    """
+    if isinstance(episodes, bool) or not isinstance(episodes, numbers.Integral) or episodes < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
+    episodes, seed = int(episodes), int(seed)
+    if map_mode is not None:
+        if map_mode not in ("static", "dynamic"):
+            raise ValueError(f"map_mode must be 'static' or 'dynamic', got {map_mode!r}")
+        if not isinstance(env, Mapping):
+            raise ValueError("map_mode= needs env kwargs; set it on the env you pass instead")
+        env = {**env, "map_mode": map_mode}
+    for level in coverage_levels:
+        if not 0.0 < level <= 1.0:
+            raise ValueError(f"coverage_levels must lie in (0, 1], got {level!r}")
+    if max_steps is not None and max_steps < 1:
+        raise ValueError(f"max_steps must be >= 1 or None, got {max_steps!r}")
+    instance, owned = _build_env(env)
+    try:
+        view = _TeamView(instance)
+        policy.attach(instance)
+        records = []
+        for i in range(episodes):
+            record = run_episode(view, policy, seed + i, coverage_levels, max_steps)
+            records.append(record)
+            if on_episode is not None:
+                on_episode(i, record)
+    finally:
+        if owned:
+            instance.close()
+    config = _config_of(instance)
+    config_dict = None
+    map_mode = map_seed = None
+    if config is not None:
+        from frontier_marl.config import config_to_dict
+
+        config_dict = config_to_dict(config)
+        map_mode = config.map_mode
+        map_seed = config.map_seed if config.map_mode == "static" else None
+    return EvaluationResult(
+        policy=getattr(policy, "name", type(policy).__name__),
+        seed=seed,
+        n_slots=view.n_slots,
+        n_agents=len(view.agents),
+        coverage_levels=tuple(float(level) for level in coverage_levels),
+        episodes=records,
+        config=config_dict,
+        map_mode=map_mode,
+        map_seed=map_seed,
+    )

@@ -1,0 +1,10 @@
+"""DQN training through SuperSuit and Stable-Baselines3 (issue 4).
+
+* :mod:`~frontier_marl.training.experiment`: TOML experiment configs (``training/*.toml``).
+* :mod:`~frontier_marl.training.vec_env`: ParallelEnv -> SuperSuit -> SB3 vector env.
+* :mod:`~frontier_marl.training.train`: the training loop, checkpoints, resume, Ctrl-C.
+* :mod:`~frontier_marl.training.evaluate_model`: thesis evaluation of a saved model.
+* :mod:`~frontier_marl.training.metadata`: what is saved beside a model, and the mismatch check.
+
+Submodules import torch / SB3 lazily where they can; import them directly.
+"""

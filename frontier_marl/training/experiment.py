@@ -1,0 +1,253 @@
+"""Experiment configs: one TOML file per thesis experiment, overridable from the command line.
+
+A config file has four parts (every one optional except ``name``)::
+
+    name = "config01"
+    description = "absolute centroids + agent position, unsorted, Reward 2"
+
+    [env]            # flat keywords of frontier_marl.make_config (preset, centroid, reward, ...)
+    preset = "thesis-20x20"
+    reward = "reward2"
+
+    [dqn]            # keyword arguments of stable_baselines3.DQN (thesis values by default)
+    learning_rate = 5e-5
+
+    [train]          # budget, seed, vector copies, checkpoints, evaluation
+    total_timesteps = 1_000_000
+    seed = 0
+
+Overrides use ``section.key=value`` (``env.reward=reward1``, ``dqn.learning_rate=1e-4``,
+``train.n_envs=2``); a bare ``key=value`` goes to the one section that knows the key. Values
+are parsed as TOML (``1e-4``, ``true``, ``[64, 64]``), else kept as strings.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from frontier_marl.config import EnvConfig, config_keys, make_config
+
+#: The thesis's final DQN hyperparameters (SPEC section 5); everything else is SB3's default.
+THESIS_DQN: dict[str, Any] = {
+    "learning_rate": 5e-5,
+    "exploration_fraction": 0.7,
+    "exploration_final_eps": 0.05,
+    "batch_size": 64,
+    "buffer_size": 50_000,
+    "target_update_interval": 500,
+    "train_freq": 4,
+}
+
+#: DQN arguments the pipeline sets itself (seeding goes through set_random_seed, see DESIGN).
+_RESERVED_DQN = {
+    "policy", "env", "seed", "device", "tensorboard_log", "verbose", "_init_setup_model"
+}
+
+
+@dataclass(frozen=True)
+class TrainSettings:
+    """Budget and bookkeeping of one training run.
+
+    Attributes:
+        total_timesteps: environment steps (transitions) to train for.
+        seed: seeds torch/numpy/random, the action space, and every vector copy (distinctly).
+        n_envs: concatenated copies of the env (1 keeps ``train_freq`` in the thesis's units).
+        checkpoint_every: steps between checkpoints (model + replay buffer + metadata);
+            0 disables periodic checkpoints (the final model and Ctrl-C still save).
+        keep_checkpoints: newest checkpoints kept on disk (0 keeps all).
+        log_interval: episodes between logger dumps (TensorBoard and metrics.jsonl).
+        eval_episodes: episodes of the final deterministic evaluation (0 skips it).
+        eval_seed: first seed of the evaluation episodes.
+        torch_threads: ``torch.set_num_threads`` value (1 is fastest for this small MLP).
+        device: torch device of the model.
+    """
+
+    total_timesteps: int = 1_000_000
+    seed: int = 0
+    n_envs: int = 1
+    checkpoint_every: int = 100_000
+    keep_checkpoints: int = 2
+    log_interval: int = 10
+    eval_episodes: int = 30
+    eval_seed: int = 0
+    torch_threads: int = 1
+    device: str = "cpu"
+
+    def __post_init__(self) -> None:
+        for name, low in (
+            ("total_timesteps", 1),
+            ("seed", 0),
+            ("n_envs", 1),
+            ("checkpoint_every", 0),
+            ("keep_checkpoints", 0),
+            ("log_interval", 1),
+            ("eval_episodes", 0),
+            ("eval_seed", 0),
+            ("torch_threads", 1),
+        ):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if not isinstance(self.device, str) or not self.device:
+            raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
+
+
+_TRAIN_KEYS = {f.name for f in dataclasses.fields(TrainSettings)}
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One training experiment: env keywords, DQN keywords, and run settings."""
+
+    name: str
+    description: str = ""
+    env: dict[str, Any] = field(default_factory=dict)
+    dqn: dict[str, Any] = field(default_factory=lambda: dict(THESIS_DQN))
+    train: TrainSettings = field(default_factory=TrainSettings)
+    source: str | None = None
+
+    def env_config(self) -> EnvConfig:
+        """The validated env config (raises ``ValueError`` naming a bad env key)."""
+        kwargs = dict(self.env)
+        preset = kwargs.pop("preset", "thesis-20x20")
+        return make_config(preset, **kwargs)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON/TOML-able dictionary that :func:`experiment_from_dict` reads back."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "env": dict(self.env),
+            "dqn": dict(self.dqn),
+            "train": dataclasses.asdict(self.train),
+        }
+
+
+def dqn_keys() -> set[str]:
+    """Keyword arguments of ``stable_baselines3.DQN`` that a config may set."""
+    from stable_baselines3 import DQN
+
+    return set(inspect.signature(DQN.__init__).parameters) - {"self"} - _RESERVED_DQN
+
+
+def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> Experiment:
+    """Build and validate an :class:`Experiment` from a parsed config file."""
+    where = f" in {source}" if source else ""
+    unknown = set(data) - {"name", "description", "env", "dqn", "train"}
+    if unknown:
+        raise ValueError(
+            f"unknown top-level key(s) {sorted(unknown)}{where}; "
+            "allowed: name, description, [env], [dqn], [train]"
+        )
+    name = data.get("name")
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"an experiment needs a non-empty string 'name'{where}")
+    for section in ("env", "dqn", "train"):
+        if not isinstance(data.get(section, {}), Mapping):
+            raise ValueError(f"[{section}] must be a table{where}")
+    env = dict(data.get("env", {}))
+    dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
+    train_kw = dict(data.get("train", {}))
+    bad_train = set(train_kw) - _TRAIN_KEYS
+    if bad_train:
+        raise ValueError(
+            f"unknown [train] key(s) {sorted(bad_train)}{where}; allowed: {sorted(_TRAIN_KEYS)}"
+        )
+    bad_dqn = set(dqn) - dqn_keys()
+    if bad_dqn:
+        raise ValueError(
+            f"unknown or reserved [dqn] key(s) {sorted(bad_dqn)}{where}; "
+            f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
+        )
+    experiment = Experiment(
+        name=name,
+        description=str(data.get("description", "")),
+        env=env,
+        dqn=dqn,
+        train=TrainSettings(**train_kw),
+        source=source,
+    )
+    try:
+        experiment.env_config()
+    except ValueError as exc:
+        raise ValueError(f"[env]{where}: {exc}") from exc
+    return experiment
+
+
+def parse_override(text: str) -> tuple[str, str, Any]:
+    """``'section.key=value'`` or ``'key=value'`` -> (section, key, parsed value)."""
+    if "=" not in text:
+        raise ValueError(f"override must look like key=value or section.key=value, got {text!r}")
+    key, raw = text.split("=", 1)
+    key = key.strip()
+    value = _parse_value(raw.strip())
+    if "." in key:
+        section, name = key.split(".", 1)
+        if section not in ("env", "dqn", "train"):
+            raise ValueError(
+                f"override section must be env, dqn or train, got {section!r} in {text!r}"
+            )
+        return section, name, value
+    owners = [
+        section
+        for section, keys in (
+            ("train", _TRAIN_KEYS),
+            ("dqn", dqn_keys()),
+            ("env", set(config_keys())),
+        )
+        if key in keys
+    ]
+    if not owners:
+        raise ValueError(
+            f"unknown override key {key!r}: not an env, dqn or train key "
+            "(use section.key=value to be explicit)"
+        )
+    if len(owners) > 1:
+        raise ValueError(f"override key {key!r} is ambiguous ({owners}): write section.{key}")
+    return owners[0], key, value
+
+
+def _parse_value(raw: str) -> Any:
+    try:
+        return tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        return raw
+
+
+def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str]) -> dict[str, Any]:
+    """A copy of a parsed config with ``key=value`` overrides applied."""
+    out: dict[str, Any] = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in data.items()}
+    for text in overrides:
+        section, key, value = parse_override(text)
+        out.setdefault(section, {})[key] = value
+    return out
+
+
+def resolve_config_path(config: str | Path) -> Path:
+    """A config file path, or the name of a file in the repository's ``training/`` folder."""
+    path = Path(config)
+    if path.is_file():
+        return path
+    candidates = [path.with_suffix(".toml")] if path.suffix != ".toml" else []
+    for folder in (Path.cwd() / "training", Path(__file__).resolve().parents[2] / "training"):
+        candidates += [folder / path.name, folder / f"{path.name}.toml"]
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise ValueError(f"config file {str(config)!r} not found (looked in . and training/)")
+
+
+def load_experiment(config: str | Path, overrides: Iterable[str] = ()) -> Experiment:
+    """Read a TOML experiment file (path or name under ``training/``) and apply overrides."""
+    path = resolve_config_path(config)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"cannot parse {path}: {exc}") from exc
+    return experiment_from_dict(apply_overrides(data, overrides), source=str(path))

@@ -1,0 +1,100 @@
+"""Figures of a training run: action histogram and learning curve (PNG, matplotlib Agg)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.training.evaluate_model import DEGENERACY_THRESHOLD
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_action_histogram(
+    rows: Sequence[Mapping[str, Any]], path: str | os.PathLike[str], title: str | None = None
+) -> None:
+    """Grouped bars: share of each slot per policy row, with the degeneracy threshold."""
+    if not rows:
+        raise ValueError("rows must not be empty")
+    plt = _pyplot()
+    n_slots = max(len(row["action_shares"]) for row in rows)
+    x = np.arange(n_slots)
+    width = 0.8 / len(rows)
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    try:
+        for i, row in enumerate(rows):
+            shares = np.zeros(n_slots)
+            shares[: len(row["action_shares"])] = row["action_shares"]
+            offset = (i - (len(rows) - 1) / 2) * width
+            label = f"{row['policy']} ({row['mean_reward']:.2f} ± {row['std_reward']:.2f})"
+            ax.bar(x + offset, shares, width, label=label, color=f"C{i}")
+        ax.axhline(DEGENERACY_THRESHOLD, color="C3", linestyle="--", linewidth=1,
+                   label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})")
+        ax.set_xticks(x, [f"slot {k}" for k in x])
+        ax.set_ylim(0, 1.05)
+        ax.set_ylabel("share of decisions")
+        ax.legend(fontsize=8, loc="upper right")
+        ax.set_title(title or "actions chosen (deterministic evaluation)", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(os.fspath(path), dpi=110)
+    finally:
+        plt.close(fig)
+
+
+def _series(rows: Sequence[Mapping[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
+    pairs = [(row["step"], row[key]) for row in rows if key in row]
+    if not pairs:
+        return np.zeros(0), np.zeros(0)
+    steps, values = zip(*pairs, strict=True)
+    return np.asarray(steps, float), np.asarray(values, float)
+
+
+def plot_learning_curve(
+    metrics: Sequence[Mapping[str, Any]],
+    path: str | os.PathLike[str],
+    title: str | None = None,
+    reference: Mapping[str, float] | None = None,
+) -> None:
+    """Three panels against training steps: mean episode reward (SB3's rolling
+    ``rollout/ep_rew_mean``), TD loss (``train/loss``, log scale) and epsilon
+    (``rollout/exploration_rate``). ``reference`` maps labels to horizontal reward lines."""
+    plt = _pyplot()
+    fig, (reward, loss, eps) = plt.subplots(1, 3, figsize=(13, 3.6))
+    try:
+        steps, values = _series(metrics, "rollout/ep_rew_mean")
+        reward.plot(steps, values, color="C0")
+        for i, (label, value) in enumerate((reference or {}).items()):
+            reward.axhline(value, color=f"C{i + 1}", linestyle=":", linewidth=1, label=label)
+        if reference:
+            reward.legend(fontsize=8, loc="lower right")
+        reward.set_title("episode reward (rolling mean of 100)", fontsize=9)
+        steps, values = _series(metrics, "train/loss")
+        loss.plot(steps, values, color="C1", linewidth=0.8)
+        if len(values) and np.all(values > 0):
+            loss.set_yscale("log")
+        loss.set_title("TD loss (Huber)", fontsize=9)
+        steps, values = _series(metrics, "rollout/exploration_rate")
+        eps.plot(steps, values, color="C2")
+        eps.set_ylim(0, 1.05)
+        eps.set_title("epsilon", fontsize=9)
+        for ax in (reward, loss, eps):
+            ax.set_xlabel("environment steps")
+            if not ax.lines:
+                ax.text(0.5, 0.5, "no data yet", ha="center", va="center",
+                        transform=ax.transAxes, color="0.5")
+        if title:
+            fig.suptitle(title, fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.fspath(path), dpi=110)
+    finally:
+        plt.close(fig)

@@ -1,0 +1,346 @@
+"""The training loop: one experiment -> a run folder with model, logs, checkpoints, evaluation.
+
+Run folder::
+
+    RUN/model.zip, model.json        final model + metadata (env config, observation layout)
+    RUN/evaluation.json              30-episode deterministic evaluation beside greedy-distance
+    RUN/actions.png                  action histogram of that evaluation
+    RUN/learning_curve.png           episode reward, TD loss and epsilon against steps
+    RUN/metrics.jsonl                every logger dump (the learning curve's data)
+    RUN/tb/                          TensorBoard: rollout/ep_rew_mean, train/loss,
+                                     rollout/exploration_rate
+    RUN/checkpoints/step_*/          model + replay buffer + metadata (newest ``keep`` kept)
+    RUN/run.json                     the experiment and one entry per training session
+
+Seeding follows DESIGN's traps: ``DQN(seed=...)`` is never used (SuperSuit's ``ConcatVecEnv``
+has no ``seed``); ``set_random_seed`` seeds python/numpy/torch, the action space is seeded for
+the epsilon-random actions, and every vector copy is reset with its own seed. A resumed session
+derives its seeds from ``(seed, step)`` so it does not replay the first session's episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.training.checkpoints import (
+    Checkpoint,
+    find_checkpoint,
+    list_checkpoints,
+    save_checkpoint,
+)
+from frontier_marl.training.experiment import Experiment, TrainSettings, experiment_from_dict
+from frontier_marl.training.metadata import build_metadata, save_metadata
+
+#: Train settings a resumed run may change; everything else must match the checkpoint.
+RESUMABLE_TRAIN_KEYS = {
+    "total_timesteps",
+    "checkpoint_every",
+    "keep_checkpoints",
+    "log_interval",
+    "eval_episodes",
+    "eval_seed",
+    "torch_threads",
+}
+
+
+@dataclass
+class TrainResult:
+    """What :func:`train` produced."""
+
+    run_dir: Path
+    model_path: Path
+    num_timesteps: int
+    steps_this_session: int
+    wall_time_s: float
+    interrupted: bool
+    evaluation: dict[str, Any] | None = None
+    files: dict[str, Path] = field(default_factory=dict)
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps_this_session / self.wall_time_s if self.wall_time_s > 0 else 0.0
+
+
+def default_run_dir(experiment: Experiment, root: str | Path = "runs") -> Path:
+    return Path(root) / experiment.name / f"seed{experiment.train.seed}"
+
+
+def policy_name(observation_space: Any) -> str:
+    """``MultiInputPolicy`` for Dict observations, ``MlpPolicy`` for flat ones (SPEC 5)."""
+    from gymnasium import spaces
+
+    return "MultiInputPolicy" if isinstance(observation_space, spaces.Dict) else "MlpPolicy"
+
+
+def session_seed(seed: int, start_step: int) -> int:
+    """The seed of a session starting at ``start_step`` (``seed`` itself for a fresh run)."""
+    if start_step == 0:
+        return seed
+    return int(np.random.SeedSequence([seed, start_step]).generate_state(1)[0])
+
+
+def resume_experiment(checkpoint: Checkpoint, overrides: dict[str, Any] | None = None) -> Experiment:
+    """The checkpoint's experiment with allowed ``train`` overrides applied."""
+    meta = checkpoint.metadata()
+    saved = meta.get("experiment")
+    if not saved:
+        raise ValueError(f"checkpoint {checkpoint.path} has no saved experiment in model.json")
+    data = json.loads(json.dumps(saved))
+    for key, value in (overrides or {}).items():
+        if key not in RESUMABLE_TRAIN_KEYS:
+            raise ValueError(
+                f"cannot change train.{key} when resuming (allowed: "
+                f"{', '.join(sorted(RESUMABLE_TRAIN_KEYS))}); env and dqn settings are fixed "
+                "by the checkpoint"
+            )
+        data["train"][key] = value
+    return experiment_from_dict(data, source=str(checkpoint.path))
+
+
+def train(
+    experiment: Experiment,
+    run_dir: str | Path,
+    *,
+    resume: Checkpoint | str | Path | None = None,
+    progress_bar: bool = True,
+    verbose: int = 0,
+) -> TrainResult:
+    """Train (or resume) one experiment into ``run_dir``; Ctrl-C saves a checkpoint."""
+    import torch
+    from stable_baselines3 import DQN
+    from stable_baselines3.common.utils import set_random_seed
+
+    from frontier_marl.training.vec_env import make_vec_env
+
+    settings: TrainSettings = experiment.train
+    run_dir = Path(run_dir)
+    if resume is None or isinstance(resume, Checkpoint):
+        checkpoint = resume
+    else:
+        checkpoint = find_checkpoint(resume)
+    if checkpoint is None and ((run_dir / "model.zip").exists() or list_checkpoints(run_dir)):
+        raise ValueError(
+            f"run folder {str(run_dir)!r} already holds a run: continue it with "
+            f"--resume {run_dir} or choose another --out"
+        )
+    run_dir.mkdir(parents=True, exist_ok=True)
+    torch.set_num_threads(settings.torch_threads)
+
+    cfg = experiment.env_config()
+    start_step = 0 if checkpoint is None else checkpoint.step
+    seed = session_seed(settings.seed, start_step)
+    set_random_seed(seed)
+    vec_env = make_vec_env({"config": cfg}, settings.n_envs, seed=seed)
+    if checkpoint is None:
+        model = DQN(
+            policy_name(vec_env.observation_space),
+            vec_env,
+            device=settings.device,
+            verbose=verbose,
+            **experiment.dqn,
+        )
+    else:
+        model = DQN.load(checkpoint.model, env=vec_env, device=settings.device)
+        if checkpoint.replay_buffer.is_file():
+            model.load_replay_buffer(checkpoint.replay_buffer)
+        start_step = model.num_timesteps
+    model.action_space.seed(seed)
+    policy = policy_name(model.observation_space)
+    _set_logger(model, run_dir, start_step, checkpoint is not None, verbose)
+
+    def metadata() -> dict[str, Any]:
+        return build_metadata(
+            cfg,
+            model.observation_space,
+            model.action_space,
+            policy=policy,
+            num_timesteps=model.num_timesteps,
+            experiment=experiment.to_dict(),
+            extra={"seed": settings.seed, "session_seed": seed},
+        )
+
+    def checkpoint_now(m: Any) -> Checkpoint:
+        return save_checkpoint(m, run_dir, metadata(), keep=settings.keep_checkpoints)
+
+    callbacks: list[Any] = []
+    progress = None
+    if progress_bar:
+        from frontier_marl.training.callbacks import ProgressBar
+
+        progress = ProgressBar()
+        callbacks.append(progress)
+    if settings.checkpoint_every > 0:
+        from frontier_marl.training.callbacks import PeriodicCheckpoint
+
+        callbacks.append(PeriodicCheckpoint(settings.checkpoint_every, checkpoint_now))
+
+    remaining = settings.total_timesteps - model.num_timesteps
+    interrupted = False
+    started = time.perf_counter()
+    try:
+        if remaining > 0:
+            model.learn(
+                remaining,
+                callback=callbacks,
+                log_interval=settings.log_interval,
+                reset_num_timesteps=checkpoint is None,
+            )
+    except KeyboardInterrupt:
+        interrupted = True
+        if progress is not None:
+            progress.close()
+    wall = time.perf_counter() - started
+    steps_done = model.num_timesteps - start_step
+
+    files: dict[str, Path] = {}
+    last = checkpoint_now(model)
+    files["checkpoint"] = last.path
+    model_path = run_dir / "model.zip"
+    model.save(model_path)
+    meta = metadata()
+    meta["training"] = {"wall_time_s": wall, "steps_this_session": steps_done}
+    save_metadata(meta, run_dir / "model.json")
+    files["model"] = model_path
+    files["metadata"] = run_dir / "model.json"
+    _record_session(run_dir, experiment, start_step, model.num_timesteps, wall, interrupted,
+                    None if checkpoint is None else checkpoint.path)
+    model.logger.close()
+    vec_env.close()
+
+    result = TrainResult(
+        run_dir=run_dir,
+        model_path=model_path,
+        num_timesteps=model.num_timesteps,
+        steps_this_session=steps_done,
+        wall_time_s=wall,
+        interrupted=interrupted,
+        files=files,
+    )
+    _plot_learning_curve(run_dir, experiment, result)
+    if not interrupted and settings.eval_episodes > 0:
+        result.evaluation = _final_evaluation(model, model_path, meta, cfg, settings, run_dir,
+                                              experiment, result)
+    return result
+
+
+def _set_logger(model: Any, run_dir: Path, start_step: int, resumed: bool, verbose: int) -> None:
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
+
+    from frontier_marl.training.callbacks import JsonLinesWriter, truncate_metrics
+
+    metrics = run_dir / "metrics.jsonl"
+    if resumed:
+        truncate_metrics(metrics, start_step)
+    elif metrics.exists():
+        metrics.unlink()
+    outputs: list[Any] = [
+        TensorBoardOutputFormat(str(run_dir / "tb")),
+        JsonLinesWriter(metrics),
+    ]
+    if verbose:
+        import sys
+
+        outputs.append(HumanOutputFormat(sys.stdout))
+    model.set_logger(Logger(folder=str(run_dir), output_formats=outputs))
+
+
+def _record_session(
+    run_dir: Path,
+    experiment: Experiment,
+    start: int,
+    end: int,
+    wall: float,
+    interrupted: bool,
+    resumed_from: Path | None,
+) -> None:
+    path = run_dir / "run.json"
+    record = json.loads(path.read_text()) if path.is_file() else {"sessions": []}
+    record["experiment"] = experiment.to_dict()
+    record["sessions"].append(
+        {
+            "start_step": start,
+            "end_step": end,
+            "wall_time_s": round(wall, 3),
+            "steps_per_second": round((end - start) / wall, 1) if wall > 0 else None,
+            "interrupted": interrupted,
+            "resumed_from": None if resumed_from is None else str(resumed_from),
+            "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
+        }
+    )
+    path.write_text(json.dumps(record, indent=2) + "\n")
+
+
+def _plot_learning_curve(run_dir: Path, experiment: Experiment, result: TrainResult) -> None:
+    from frontier_marl.training.callbacks import read_metrics
+    from frontier_marl.training.plots import plot_learning_curve
+
+    path = run_dir / "learning_curve.png"
+    plot_learning_curve(
+        read_metrics(run_dir / "metrics.jsonl"),
+        path,
+        title=f"{experiment.name} (seed {experiment.train.seed}, {result.num_timesteps} steps)",
+    )
+    result.files["learning_curve"] = path
+
+
+def _final_evaluation(
+    model: Any,
+    model_path: Path,
+    meta: dict[str, Any],
+    cfg: Any,
+    settings: TrainSettings,
+    run_dir: Path,
+    experiment: Experiment,
+    result: TrainResult,
+) -> dict[str, Any]:
+    from frontier_marl.training.evaluate_model import LoadedModel, evaluate_model
+    from frontier_marl.training.plots import plot_action_histogram
+
+    loaded = LoadedModel(model=model, path=model_path, metadata=meta)
+    evaluation = evaluate_model(
+        loaded, cfg, episodes=settings.eval_episodes, seed=settings.eval_seed,
+        name=experiment.name,
+    )
+    evaluation["experiment"] = experiment.name
+    path = run_dir / "evaluation.json"
+    write_json(evaluation, path)
+    plot_action_histogram(
+        evaluation["rows"],
+        run_dir / "actions.png",
+        title=f"{experiment.name}: actions over {settings.eval_episodes} deterministic episodes",
+    )
+    result.files["evaluation"] = path
+    result.files["actions"] = run_dir / "actions.png"
+    return evaluation
+
+
+def write_json(data: Any, path: str | Path) -> Path:
+    """JSON with non-finite floats as ``null`` and numpy values as Python ones."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(_json_safe(data), indent=1) + "\n")
+    return path
+
+
+def _json_safe(value: Any) -> Any:
+    import math
+
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, np.ndarray):
+        return _json_safe(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    return value

@@ -1,0 +1,108 @@
+"""The training env: ParallelEnv -> SuperSuit vector env -> SB3 ``VecMonitor``.
+
+Pipeline (SPEC section 5, DESIGN "Known traps")::
+
+    FrontierParallelEnv
+      -> TimeLimitInfo                 (marks truncations for SB3's replay buffer)
+      -> supersuit.pettingzoo_env_to_vec_env_v1     (one vector slot per robot)
+      -> supersuit.concat_vec_envs_v1(..., base_class="stable_baselines3")   (n_envs copies)
+      -> stable_baselines3 VecMonitor                (episode reward/length for the logger)
+
+SuperSuit's SB3 wrapper folds ``terminated or truncated`` into ``dones`` and drops the
+difference, so SB3 would treat a truncation (step limit, no progress, Reward 1's padding
+action) as terminal and stop bootstrapping there. :class:`TimeLimitInfo` puts SB3's
+``info["TimeLimit.truncated"] = True`` on truncated-but-not-terminated steps; the replay
+buffer (``handle_timeout_termination=True``) then stores the step as a timeout and the TD
+target keeps bootstrapping from the terminal observation.
+
+Seeding: SuperSuit's ``ConcatVecEnv`` has no ``seed`` (so ``DQN(seed=...)`` and
+``VecEnv.seed`` crash) and its copies are clones of one env. :func:`seed_vec_env` resets every
+copy with its own seed spawned from one ``numpy.random.SeedSequence``; later unseeded resets
+(SB3 resets the env when learning starts) continue each copy's own generator.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from pettingzoo.utils.wrappers import BaseParallelWrapper
+
+from frontier_marl.envs.parallel import FrontierParallelEnv
+
+TRUNCATED_KEY = "TimeLimit.truncated"
+
+
+class TimeLimitInfo(BaseParallelWrapper):
+    """Adds ``info["TimeLimit.truncated"]`` to agents whose episode was truncated, not ended.
+
+    The only work on an ordinary step is one ``any()`` over the truncation flags.
+    """
+
+    def step(self, actions: dict[str, Any]) -> tuple[Any, Any, Any, Any, Any]:
+        observations, rewards, terminations, truncations, infos = self.env.step(actions)
+        if any(truncations.values()):
+            for agent, truncated in truncations.items():
+                if truncated and not terminations[agent]:
+                    infos[agent][TRUNCATED_KEY] = True
+        return observations, rewards, terminations, truncations, infos
+
+
+def make_parallel_env(env_kwargs: dict[str, Any]) -> TimeLimitInfo:
+    """The wrapped ParallelEnv for ``env_kwargs`` (flat keywords of ``make_config``)."""
+    return TimeLimitInfo(FrontierParallelEnv(**env_kwargs))
+
+
+def make_vec_env(env_kwargs: dict[str, Any], n_envs: int = 1, seed: int | None = None) -> Any:
+    """An SB3 ``VecMonitor`` over ``n_envs`` SuperSuit copies of the env (see module doc).
+
+    With ``seed`` the copies are reset once with distinct seeds (:func:`seed_vec_env`).
+    """
+    import supersuit as ss
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
+        raise ValueError(f"n_envs must be an integer >= 1, got {n_envs!r}")
+    markov = ss.pettingzoo_env_to_vec_env_v1(make_parallel_env(env_kwargs))
+    vec = ss.concat_vec_envs_v1(markov, n_envs, num_cpus=0, base_class="stable_baselines3")
+    with warnings.catch_warnings():
+        # SuperSuit's ConcatVecEnv has no get_attr, so SB3 cannot read render_mode (harmless)
+        warnings.filterwarnings("ignore", message="The `render_mode` attribute is not defined")
+        monitored = VecMonitor(vec)
+    if seed is not None:
+        seed_vec_env(monitored, seed)
+    return monitored
+
+
+def copy_seeds(seed: int, n: int) -> list[int]:
+    """``n`` independent 32-bit seeds derived from ``seed`` (one per vector copy)."""
+    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(n)]
+
+
+def concat_vec_env(vec: Any) -> Any:
+    """The SuperSuit ``ConcatVecEnv`` inside an SB3 wrapper chain."""
+    inner = vec
+    while not hasattr(inner, "vec_envs"):
+        if not hasattr(inner, "venv"):
+            raise ValueError(f"no SuperSuit ConcatVecEnv inside {type(vec).__name__}")
+        inner = inner.venv
+    return inner
+
+
+def parallel_envs(vec: Any) -> list[Any]:
+    """The wrapped ParallelEnv of every copy, in vector order."""
+    return [markov.par_env for markov in concat_vec_env(vec).vec_envs]
+
+
+def seed_vec_env(vec: Any, seed: int) -> list[int]:
+    """Reset every copy once with its own seed; returns the seeds used.
+
+    The observations of this reset are discarded: SB3 resets the vector env again when
+    learning starts, and that unseeded reset draws from each copy's seeded generator.
+    """
+    copies = concat_vec_env(vec).vec_envs
+    seeds = copy_seeds(seed, len(copies))
+    for markov, copy_seed in zip(copies, seeds, strict=True):
+        markov.reset(seed=copy_seed)
+    return seeds
