@@ -1,0 +1,222 @@
+"""Tests for frontier_marl.policies: each heuristic on hand-made infos, and on the real envs."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import frontier_marl
+from frontier_marl.core.grid import FREE, OCCUPIED
+from frontier_marl.policies import (
+    POLICIES,
+    CallablePolicy,
+    CostUtility,
+    GreedyDistance,
+    GreedyGain,
+    ModelPolicy,
+    RandomValid,
+    make_policy,
+)
+
+
+def cluster(slot: int, gain: float, distance: float, target=(0, 0), size=None) -> dict:
+    return {
+        "slot": slot,
+        "cluster": slot,
+        "centroid": (float(target[0]), float(target[1])),
+        "target": target,
+        "size": int(gain) if size is None else size,
+        "gain": float(gain),
+        "distance": float(distance),
+    }
+
+
+def info_with(clusters: list[dict], n_slots: int = 4, position=(0, 0), **extra) -> dict:
+    mask = np.zeros(n_slots, dtype=np.int8)
+    for c in clusters:
+        mask[c["slot"]] = 1
+    if not clusters:
+        mask[0] = 1
+    return {"clusters": clusters, "action_mask": mask, "position": position, **extra}
+
+
+# ----------------------------------------------------------------- greedy distance / gain
+
+
+def test_greedy_distance_picks_the_nearest_centroid():
+    info = info_with([cluster(0, 9, 4.0), cluster(1, 2, 1.5), cluster(2, 5, 3.0)])
+    assert GreedyDistance().act(None, info) == 1
+
+
+def test_greedy_distance_ties_go_to_the_lowest_slot():
+    info = info_with([cluster(3, 1, 2.0), cluster(1, 9, 2.0), cluster(2, 5, 3.0)])
+    assert GreedyDistance().act(None, info) == 1
+
+
+def test_greedy_gain_picks_the_largest_gain():
+    info = info_with([cluster(0, 3, 1.0), cluster(1, 2, 1.5), cluster(2, 7, 6.0)])
+    assert GreedyGain().act(None, info) == 2
+
+
+def test_greedy_gain_ties_go_to_the_nearest_then_the_lowest_slot():
+    info = info_with([cluster(0, 7, 5.0), cluster(1, 2, 0.5), cluster(3, 7, 2.0)])
+    assert GreedyGain().act(None, info) == 3
+    info = info_with([cluster(2, 7, 2.0), cluster(1, 7, 2.0)])
+    assert GreedyGain().act(None, info) == 1
+
+
+@pytest.mark.parametrize("name", list(POLICIES))
+def test_no_live_cluster_gives_slot_0(name):
+    policy = make_policy(name, seed=0)
+    assert policy.act(None, info_with([], belief=np.zeros((3, 3), np.int8))) == 0
+
+
+# ----------------------------------------------------------------- cost-utility
+
+# 3 x 7 known map; a wall on row 1 (cols 0-5) separates the robot at (0, 0) from (2, 0):
+#   R . . . . . B        A: target (2, 0), Euclidean 2 away but 14 cells by path
+#   # # # # # # .        B: target (0, 6), 6 cells away
+#   A . . . . . .
+WALLED = np.full((3, 7), FREE, dtype=np.int8)
+WALLED[1, :6] = OCCUPIED
+
+
+def walled_info(gain_a: float, gain_b: float) -> dict:
+    return info_with(
+        [cluster(0, gain_a, 2.0, target=(2, 0)), cluster(1, gain_b, 6.0, target=(0, 6))],
+        position=(0, 0),
+        belief=WALLED,
+    )
+
+
+def test_cost_utility_uses_path_length_not_euclidean_distance():
+    info = walled_info(gain_a=4, gain_b=3)  # utilities 4/14 and 3/6
+    policy = CostUtility()
+    assert policy.path_lengths(info) == {0: 14, 1: 6}
+    assert policy.utilities(info) == pytest.approx({0: 4 / 14, 1: 0.5})
+    assert policy.act(None, info) == 1
+    # the other heuristics prefer A (nearer by Euclid, larger gain)
+    assert GreedyDistance().act(None, info) == 0
+    assert GreedyGain().act(None, info) == 0
+
+
+def test_cost_utility_prefers_a_large_enough_gain_behind_the_wall():
+    assert CostUtility().act(None, walled_info(gain_a=10, gain_b=3)) == 0  # 10/14 > 3/6
+
+
+def test_cost_utility_ties_go_to_the_nearest():
+    # 7/14 == 3/6: tie on utility, then the smaller Euclidean distance (A: 2.0)
+    assert CostUtility().act(None, walled_info(gain_a=7, gain_b=3)) == 0
+
+
+def test_cost_utility_needs_a_map():
+    info = walled_info(4, 3)
+    del info["belief"]
+    with pytest.raises(ValueError, match="belief"):
+        CostUtility().act(None, info)
+
+
+def test_cost_utility_attached_env_matches_explicit_belief():
+    env = frontier_marl.parallel_env(height=8, width=9, obstacle_prob=0.15)
+    attached = CostUtility()
+    attached.attach(env)
+    explicit = CostUtility()
+    obs, infos = env.reset(seed=3)
+    steps = 0
+    while env.agents and steps < 15:
+        info = infos["robot_0"]
+        action = attached.act(obs["robot_0"], info)
+        assert action == explicit.act(None, {**info, "belief": env.world.belief})
+        obs, _, _, _, infos = env.step({"robot_0": action})
+        steps += 1
+    assert steps > 3
+
+
+def test_cost_utility_attach_rejects_an_env_without_a_world():
+    with pytest.raises(ValueError, match="world"):
+        CostUtility().attach(object())
+
+
+# ----------------------------------------------------------------- random
+
+
+def test_random_draws_only_valid_slots_uniformly_and_reproducibly():
+    info = info_with([cluster(1, 1, 1.0), cluster(3, 1, 1.0)], n_slots=5)
+    policy = RandomValid()
+    policy.reset(7)
+    draws = [policy.act(None, info) for _ in range(400)]
+    assert set(draws) == {1, 3}
+    assert 150 < draws.count(1) < 250
+    again = make_policy("random", seed=7)
+    assert [again.act(None, info) for _ in range(400)] == draws
+
+
+# ----------------------------------------------------------------- interface
+
+
+def test_make_policy_lists_valid_names():
+    with pytest.raises(ValueError, match="greedy-distance.*greedy-gain.*cost-utility.*random"):
+        make_policy("nearest")
+    assert make_policy("greedy-gain").name == "greedy-gain"
+
+
+def test_act_team_decides_for_every_robot_independently():
+    infos = {
+        "robot_0": info_with([cluster(0, 1, 3.0), cluster(1, 1, 1.0)]),
+        "robot_1": info_with([cluster(0, 1, 0.5), cluster(2, 1, 1.0)]),
+    }
+    actions = GreedyDistance().act_team({"robot_0": None, "robot_1": None}, infos)
+    assert actions == {"robot_0": 1, "robot_1": 0}
+
+
+def test_callable_and_model_adapters():
+    assert CallablePolicy(lambda obs: np.array([2])).act(None, {}) == 2
+
+    class FakeModel:
+        def predict(self, obs, deterministic=True):
+            return np.int64(3 if deterministic else 0), None
+
+    assert ModelPolicy(FakeModel()).act(np.zeros(3), {}) == 3
+    with pytest.raises(ValueError, match="predict"):
+        ModelPolicy(object())
+    with pytest.raises(ValueError, match="one slot"):
+        CallablePolicy(lambda obs: [1, 2]).act(None, {})
+
+
+@pytest.mark.parametrize("name", list(POLICIES))
+def test_heuristics_choose_valid_slots_in_a_team(name):
+    env = frontier_marl.parallel_env(
+        height=10, width=10, n_agents=2, obstacle_prob=0.15, explore_threshold=0.8
+    )
+    policy = make_policy(name, seed=1)
+    policy.attach(env)
+    obs, infos = env.reset(seed=1)
+    steps = 0
+    while env.agents:
+        actions = policy.act_team(obs, infos)
+        assert set(actions) == {"robot_0", "robot_1"}
+        for agent, slot in actions.items():
+            assert infos[agent]["action_mask"][slot] == 1
+        obs, _, _, _, infos = env.step(actions)
+        steps += 1
+    assert steps >= 1
+
+
+def test_heuristic_drives_the_gymnasium_env():
+    # explore_threshold < 1 so that the episode ends before the last frontier vanishes (see
+    # test_evaluation.py::test_fully_known_map_gives_exact_numbers for that case).
+    env = gym.make(
+        frontier_marl.GYM_ID, height=8, width=8, obstacle_prob=0.1, perception_range=2,
+        explore_threshold=0.8,
+    )
+    policy = make_policy("cost-utility")
+    policy.attach(env)
+    obs, info = env.reset(seed=0)
+    done = False
+    while not done:
+        action = policy.act(obs, info)
+        assert info["action_mask"][action] == 1
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    assert info["end_reason"] == "threshold"
