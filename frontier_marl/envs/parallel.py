@@ -76,6 +76,7 @@ class FrontierParallelEnv(ParallelEnv):
         self._act_space = spaces.Discrete(self.config.n_slots)
         self.observation_spaces = dict.fromkeys(self.possible_agents, self._obs_space)
         self.action_spaces = dict.fromkeys(self.possible_agents, self._act_space)
+        self.state_space = spaces.Box(-1, 1, self.config.shape, dtype=np.int8)
         self._rng: np.random.Generator | None = None
         self._last_infos: list[dict[str, Any]] | None = None
 
