@@ -19,18 +19,22 @@ from typing import Any, Literal
 
 CentroidEncoding = Literal["absolute", "relative", "distance", "none"]
 MapMode = Literal["static", "dynamic"]
+MapGenerator = Literal["random", "rooms"]
 SensorModel = Literal["square", "raycast"]
 GainModel = Literal["size", "unknown"]
 ThresholdBasis = Literal["all", "free", "reachable"]
 RewardKind = Literal["reward1", "reward2"]
+TeammateEncoding = Literal["none", "positions", "positions+targets"]
 FULL_PATH = "full"
 
 _CENTROIDS = ("absolute", "relative", "distance", "none")
 _MAP_MODES = ("static", "dynamic")
+_GENERATORS = ("random", "rooms")
 _SENSORS = ("square", "raycast")
 _GAINS = ("size", "unknown")
 _BASES = ("all", "free", "reachable")
 _REWARDS = ("reward1", "reward2")
+_TEAMMATES = ("none", "positions", "positions+targets")
 
 
 @dataclass(frozen=True)
@@ -46,6 +50,9 @@ class ObservationConfig:
         action_mask: add an ``action_mask`` key (valid slots) to a ``Dict`` observation.
         normalize: divide positions by the map size and gains by the map area (open choice;
             ``False`` keeps raw cell units as the thesis's description implies).
+        teammates: add a ``teammates`` key to the ``Dict`` observation: the other robots'
+            ``positions`` (row, col each, in agent order), or ``positions+targets`` (also the
+            cell each is heading to; zeros before its first decision or when idle).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -54,9 +61,11 @@ class ObservationConfig:
     sort_by_distance: bool = False
     action_mask: bool = False
     normalize: bool = False
+    teammates: TeammateEncoding = "none"
 
     def validate(self) -> None:
         _check_choice("centroid", self.centroid, _CENTROIDS)
+        _check_choice("teammates", self.teammates, _TEAMMATES)
         for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
             _check_bool(name, getattr(self, name))
         if self.centroid == "none" and not self.info_gain:
@@ -68,7 +77,7 @@ class ObservationConfig:
     @property
     def is_dict(self) -> bool:
         """Whether the observation space is a ``Dict`` (else a flat ``Box``)."""
-        return self.agent_position or self.action_mask
+        return self.agent_position or self.action_mask or self.teammates != "none"
 
 
 @dataclass(frozen=True)
@@ -85,6 +94,10 @@ class RewardConfig:
         oscillation_window: Reward 2 penalises a step whose target differs from the previous
             step's target but equals one of the targets chosen in the ``oscillation_window``
             steps before that (A -> B -> A cycling). Open choice.
+        team_weight: how a robot's cell reward mixes its own newly revealed cells (0, the
+            default and the thesis with one robot) with the whole team's (1):
+            ``cell_reward * ((1 - w) * own + w * team)``. The other shaping terms (no new cell,
+            padding, oscillation) stay each robot's own.
         cell_reward: reward per newly known cell.
         no_new_cell_penalty, padding_penalty, goal_bonus, step_limit_penalty,
         no_progress_penalty, oscillation_penalty: the table's constants; ``padding_penalty``
@@ -97,6 +110,7 @@ class RewardConfig:
     max_steps: int = 400
     no_progress_limit: int = 20
     oscillation_window: int = 4
+    team_weight: float = 0.0
     cell_reward: float = 0.05
     no_new_cell_penalty: float = -0.05
     padding_penalty: float | None = None
@@ -112,6 +126,7 @@ class RewardConfig:
         _check_int("max_steps", self.max_steps, 1)
         _check_int("no_progress_limit", self.no_progress_limit, 1)
         _check_int("oscillation_window", self.oscillation_window, 1)
+        _check_range("team_weight", self.team_weight, 0.0, 1.0)
         for name in (
             "cell_reward",
             "no_new_cell_penalty",
@@ -144,6 +159,8 @@ class EnvConfig:
     Attributes:
         height, width: grid size in cells.
         n_agents: robots sharing one belief grid (1 = the thesis MDP).
+        map_generator: ``random`` (independent obstacles with ``obstacle_prob``) or ``rooms``
+            (rectangular rooms joined by corridors; ``obstacle_prob`` is not used).
         obstacle_prob: probability that a cell is an obstacle (open choice).
         map_mode: ``static`` (one layout from ``map_seed``) or ``dynamic`` (new layout per reset).
         map_seed: seed of the static layout, recorded so results are comparable across runs.
@@ -165,6 +182,7 @@ class EnvConfig:
     height: int = 20
     width: int = 20
     n_agents: int = 1
+    map_generator: MapGenerator = "random"
     obstacle_prob: float = 0.2
     map_mode: MapMode = "static"
     map_seed: int = 0
@@ -187,7 +205,12 @@ class EnvConfig:
         _check_int("height", self.height, 3, 4096)
         _check_int("width", self.width, 3, 4096)
         _check_int("n_agents", self.n_agents, 1, 64)
+        _check_choice("map_generator", self.map_generator, _GENERATORS)
         _check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
+        if self.map_generator == "rooms" and min(self.height, self.width) < 5:
+            raise ValueError(
+                f"map_generator='rooms' needs height and width >= 5, got {self.height}x{self.width}"
+            )
         _check_choice("map_mode", self.map_mode, _MAP_MODES)
         _check_int("map_seed", self.map_seed, 0)
         if self.map_path is not None:
@@ -213,6 +236,11 @@ class EnvConfig:
             raise ValueError("reward must be a RewardConfig")
         self.observation.validate()
         self.reward.validate()
+        if self.observation.teammates != "none" and self.n_agents < 2:
+            raise ValueError(
+                f"teammates={self.observation.teammates!r} needs n_agents >= 2, "
+                f"got n_agents={self.n_agents}"
+            )
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -16,7 +16,12 @@ import numpy as np
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.map_files import load_map
-from frontier_marl.core.maps import largest_free_component, random_obstacle_map, sample_start_cells
+from frontier_marl.core.maps import (
+    largest_free_component,
+    random_obstacle_map,
+    rooms_map,
+    sample_start_cells,
+)
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.slots import SlotTable
 from frontier_marl.core.world import FULL_PATH, World, WorldParams
@@ -54,6 +59,7 @@ class ExplorationMDP:
         self.world: World | None = None
         self._slots: list[SlotTable] = []
         self._oscillation: list[OscillationDetector] = []
+        self._targets: list[tuple[int, int] | None] = []
         self.steps = 0
         self.steps_without_progress = 0
         self.done = True
@@ -69,11 +75,14 @@ class ExplorationMDP:
             return self._static_map
         if cfg.map_mode == "static":
             if self._static_map is None:
-                map_rng = np.random.default_rng(cfg.map_seed)
-                self._static_map = random_obstacle_map(
-                    cfg.height, cfg.width, cfg.obstacle_prob, map_rng
-                )
+                self._static_map = self._generate(np.random.default_rng(cfg.map_seed))
             return self._static_map
+        return self._generate(rng)
+
+    def _generate(self, rng: np.random.Generator) -> np.ndarray:
+        cfg = self.cfg
+        if cfg.map_generator == "rooms":
+            return rooms_map(cfg.height, cfg.width, rng)
         return random_obstacle_map(cfg.height, cfg.width, cfg.obstacle_prob, rng)
 
     def reset(
@@ -90,6 +99,7 @@ class ExplorationMDP:
         self.steps = 0
         self.steps_without_progress = 0
         self.done = False
+        self._targets = [None] * cfg.n_agents
         self._refresh_slots()
         n = cfg.n_agents
         empty_paths = [self.world.positions[i][None, :].copy() for i in range(n)]
@@ -121,6 +131,10 @@ class ExplorationMDP:
             [detector.update(t) for detector, t in zip(self._oscillation, targets, strict=True)]
         )
         moved = self.world.move(targets)
+        self._targets = [
+            None if target is None or reached else target
+            for target, reached in zip(targets, moved.reached, strict=True)
+        ]
         self.steps += 1
         revealed = int(moved.new_cells.sum())
         self.steps_without_progress = 0 if revealed else self.steps_without_progress + 1
@@ -184,10 +198,28 @@ class ExplorationMDP:
     def _observations(self) -> list[Observation]:
         assert self.world is not None
         positions = self.world.positions
+        mates = self._teammate_table(positions)
         return [
-            self.encoder.encode(table, positions[agent])
+            self.encoder.encode(
+                table,
+                positions[agent],
+                None if mates is None else np.delete(mates, agent, axis=0),
+            )
             for agent, table in enumerate(self._slots)
         ]
+
+    def _teammate_table(self, positions: np.ndarray) -> np.ndarray | None:
+        """(N, 2) positions, or (N, 4) positions and current targets; None if not observed."""
+        layout = self.cfg.observation.teammates
+        if layout == "none":
+            return None
+        if layout == "positions":
+            return positions.astype(np.float64)
+        targets = np.zeros((len(positions), 2))
+        for agent, target in enumerate(self._targets):
+            if target is not None:
+                targets[agent] = target
+        return np.concatenate([positions, targets], axis=1)
 
     def _infos(
         self,

@@ -9,7 +9,10 @@ Layout (the thesis's Table 4.1 axes, see :class:`~frontier_marl.config.Observati
 * Without the agent position (and without ``action_mask``) the observation *is* that vector
   (a ``Box``, for SB3's ``MlpPolicy``). Otherwise it is a ``Dict`` with keys ``clusters``,
   ``agent_position`` (row, col) when enabled, and ``action_mask`` (int8, 1 = live slot; slot 0
-  alone when no cluster is live, the robot then idles) when enabled (for SB3's ``MultiInputPolicy``).
+  alone when no cluster is live, the robot then idles) when enabled (for SB3's
+  ``MultiInputPolicy``).
+* ``teammates`` (Dict only): the other robots' (row, col) positions in agent order, each
+  followed by its current target cell for ``positions+targets`` (zeros when it has none).
 * With ``normalize``, rows are divided by the height, columns by the width, distances by the
   diagonal and gains by their upper bound, so every value lies in [-1, 1].
 """
@@ -38,6 +41,7 @@ class ObservationEncoder:
         self.agent_position = obs.agent_position
         self.action_mask = obs.action_mask
         self.is_dict = obs.is_dict
+        self.teammates = obs.teammates
         height, width = cfg.height, cfg.width
         cells = cfg.max_cluster_cells
         gain_high = min(float(cells if cfg.gain == "size" else 8 * cells), float(height * width))
@@ -77,10 +81,26 @@ class ObservationEncoder:
             )
         if self.action_mask:
             entries["action_mask"] = spaces.Box(0, 1, (self.n_slots,), dtype=np.int8)
+        if self.teammates != "none":
+            per_mate = 4 if self.teammates == "positions+targets" else 2
+            cell_high = np.array([height - 1, width - 1]) / self._position_scale
+            mate_high = np.tile(cell_high, (cfg.n_agents - 1) * per_mate // 2).astype(np.float32)
+            entries["teammates"] = spaces.Box(
+                np.zeros_like(mate_high), mate_high, dtype=np.float32
+            )
         self.space = spaces.Dict(entries)
 
-    def encode(self, slots: SlotTable, position: np.ndarray) -> np.ndarray | dict[str, np.ndarray]:
-        """The observation of a robot at ``position`` with slot table ``slots``."""
+    def encode(
+        self,
+        slots: SlotTable,
+        position: np.ndarray,
+        teammates: np.ndarray | None = None,
+    ) -> np.ndarray | dict[str, np.ndarray]:
+        """The observation of a robot at ``position`` with slot table ``slots``.
+
+        ``teammates`` is (N-1, 2) or (N-1, 4): the other robots' (row, col) positions, and
+        targets for ``positions+targets``; needed only when the layout includes teammates.
+        """
         features = np.zeros((self.n_slots, self.features_per_slot), dtype=np.float64)
         k = slots.live
         column = 0
@@ -103,6 +123,11 @@ class ObservationEncoder:
             out["agent_position"] = (position / self._position_scale).astype(np.float32)
         if self.action_mask:
             out["action_mask"] = slots.action_mask()
+        if self.teammates != "none":
+            if teammates is None:
+                raise ValueError("this observation layout needs the teammates' positions")
+            scale = np.tile(self._position_scale, teammates.shape[1] // 2)
+            out["teammates"] = (teammates / scale).astype(np.float32).ravel()
         return out
 
 
@@ -116,6 +141,8 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
         "action_mask": enc.action_mask,
         "sort_by_distance": cfg.observation.sort_by_distance,
         "normalize": cfg.observation.normalize,
+        "teammates": cfg.observation.teammates,
+        "n_agents": cfg.n_agents if cfg.observation.teammates != "none" else None,
         "n_slots": enc.n_slots,
         "features_per_slot": enc.features_per_slot,
         "height": cfg.height,

@@ -14,7 +14,10 @@ no new cell for N steps in a row  -0.5       -0.5       truncated
 oscillation (A -> B -> A)                    -0.05
 ================================  =========  =========  ===================================
 
-Team rules (N robots): episode-level events (threshold, step limit, no progress, Reward 1's
+Team rules (N robots): with ``team_weight`` w, a robot's cell term is
+``0.05 * ((1 - w) * own + w * team)``, ``own`` being the cells it revealed first and ``team``
+all cells the team revealed this step; the no-new-cell penalty still follows its own cells.
+Episode-level events (threshold, step limit, no progress, Reward 1's
 padding truncation) end the episode for every robot and add their term to every robot's
 reward; the per-cell and padding terms are each robot's own. "No progress" counts steps in
 which no robot revealed a cell. A robot that has no live slot at all idles without the padding
@@ -77,12 +80,17 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
     """Apply the reward table to one step's events."""
     padding = cfg.padding
     oscillation = cfg.oscillation_penalty if cfg.kind == "reward2" else 0.0
+    weight = cfg.team_weight
+    team = int(events.new_cells.sum())
     values = []
     for new, pad, osc in zip(
         events.new_cells.tolist(), events.padding.tolist(), events.oscillation.tolist(),
         strict=True,
     ):
-        value = cfg.cell_reward * new if new > 0 else cfg.no_new_cell_penalty
+        credited = (1.0 - weight) * new + weight * team if weight else new
+        value = cfg.cell_reward * credited
+        if new == 0:
+            value += cfg.no_new_cell_penalty
         if pad:
             value += padding
         if osc:

@@ -44,6 +44,11 @@ BAD_VALUES = [
     ("perception_range", 0, "perception_range"),
     ("perception_range", 21, "perception_range"),  # larger than the 20x20 map
     ("sensor", "lidar", "sensor"),
+    ("map_generator", "caves", "map_generator"),
+    ("team_weight", 1.5, "team_weight"),
+    ("team_weight", -0.1, "team_weight"),
+    ("teammates", "velocities", "teammates"),
+    ("teammates", "positions", "teammates"),  # needs n_agents >= 2
     ("cells_per_step", 0, "cells_per_step"),
     ("cells_per_step", -1, "cells_per_step"),
     ("cells_per_step", "half", "cells_per_step"),

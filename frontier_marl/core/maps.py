@@ -39,9 +39,7 @@ def free_component_of(true_grid: np.ndarray, cell: tuple[int, int]) -> np.ndarra
     return labels == label
 
 
-def sample_start_cells(
-    region: np.ndarray, count: int, rng: np.random.Generator
-) -> np.ndarray:
+def sample_start_cells(region: np.ndarray, count: int, rng: np.random.Generator) -> np.ndarray:
     """``count`` distinct cells drawn uniformly from the True cells of ``region``, as (count, 2)."""
     cells = np.argwhere(region)
     if len(cells) < count:
@@ -50,3 +48,80 @@ def sample_start_cells(
         )
     chosen = rng.choice(len(cells), size=count, replace=False)
     return cells[chosen].astype(np.int64)
+
+
+def rooms_map(
+    height: int,
+    width: int,
+    rng: np.random.Generator,
+    room_count: int | None = None,
+    min_room: int = 3,
+    max_room: int | None = None,
+    corridor_width: int = 1,
+) -> np.ndarray:
+    """Rooms and corridors: rectangular rooms joined by L-shaped corridors.
+
+    Rooms are placed at random without overlapping (one wall cell between rooms); each room
+    after the first is joined to the nearest earlier room by a corridor, so all free cells form
+    one 4-connected component. Returns a bool grid, True = occupied (walls).
+    """
+    if height < 5 or width < 5:
+        raise ValueError(f"rooms_map needs at least 5x5 cells, got {height}x{width}")
+    if max_room is None:
+        max_room = max(min_room, min(height, width) // 4)
+    if room_count is None:
+        room_count = max(2, (height * width) // ((min_room + max_room) ** 2))
+    grid = np.ones((height, width), dtype=bool)
+    rooms: list[tuple[int, int, int, int]] = []  # top, left, bottom (excl.), right (excl.)
+    for _ in range(room_count * 20):
+        if len(rooms) == room_count:
+            break
+        room_h = int(rng.integers(min_room, max_room + 1))
+        room_w = int(rng.integers(min_room, max_room + 1))
+        if room_h > height - 2 or room_w > width - 2:
+            continue
+        top = int(rng.integers(1, height - room_h))
+        left = int(rng.integers(1, width - room_w))
+        candidate = (top, left, top + room_h, left + room_w)
+        if any(_rooms_touch(candidate, other) for other in rooms):
+            continue
+        rooms.append(candidate)
+        grid[top : top + room_h, left : left + room_w] = False
+    if not rooms:
+        grid[1:-1, 1:-1] = False
+        return grid
+    centres = [
+        ((top + bottom - 1) // 2, (left + right - 1) // 2) for top, left, bottom, right in rooms
+    ]
+    for index in range(1, len(rooms)):
+        row, col = centres[index]
+        nearest = min(
+            range(index), key=lambda j: abs(centres[j][0] - row) + abs(centres[j][1] - col)
+        )
+        _carve_corridor(grid, centres[index], centres[nearest], corridor_width, rng)
+    return grid
+
+
+def _rooms_touch(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    """Whether two rooms overlap or have no wall cell between them."""
+    return not (a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1])
+
+
+def _carve_corridor(
+    grid: np.ndarray,
+    start: tuple[int, int],
+    end: tuple[int, int],
+    corridor_width: int,
+    rng: np.random.Generator,
+) -> None:
+    """Carve an L-shaped corridor (horizontal then vertical, or the reverse) between cells."""
+    (r0, c0), (r1, c1) = start, end
+    height, width = grid.shape
+    corner = (r0, c1) if rng.random() < 0.5 else (r1, c0)
+    for (a_r, a_c), (b_r, b_c) in (((r0, c0), corner), (corner, (r1, c1))):
+        top, bottom = sorted((a_r, b_r))
+        left, right = sorted((a_c, b_c))
+        grid[
+            max(top, 1) : min(bottom + corridor_width, height - 1),
+            max(left, 1) : min(right + corridor_width, width - 1),
+        ] = False
