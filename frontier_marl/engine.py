@@ -234,34 +234,48 @@ class ExplorationMDP:
         world = self.world
         fraction = world.explored_fraction(self.cfg.reward.threshold_basis)
         coverage = world.explored_fraction("reachable")
-        masks = self.action_masks()
+        positions = world.positions.tolist()
+        travelled = world.travelled.tolist()
+        new_list, padding_list, oscillation_list = (
+            new_cells.tolist(), padding.tolist(), oscillation.tolist()
+        )
         infos = []
         for agent, table in enumerate(self._slots):
+            live = table.live  # live slots come first
             clusters = [
                 {
                     "slot": slot,
-                    "cluster": int(table.cluster[slot]),
-                    "centroid": (float(table.centroid[slot, 0]), float(table.centroid[slot, 1])),
-                    "target": (int(table.target[slot, 0]), int(table.target[slot, 1])),
-                    "size": int(table.size[slot]),
-                    "gain": float(table.gain[slot]),
-                    "distance": float(table.distance[slot]),
+                    "cluster": cluster,
+                    "centroid": tuple(centroid),
+                    "target": tuple(target),
+                    "size": size,
+                    "gain": gain,
+                    "distance": distance,
                 }
-                for slot in np.flatnonzero(table.valid).tolist()
+                for slot, cluster, centroid, target, size, gain, distance in zip(
+                    range(live),
+                    table.cluster[:live].tolist(),
+                    table.centroid[:live].tolist(),
+                    table.target[:live].tolist(),
+                    table.size[:live].tolist(),
+                    table.gain[:live].tolist(),
+                    table.distance[:live].tolist(),
+                    strict=True,
+                )
             ]
             infos.append(
                 {
                     "explored_fraction": fraction,
                     "coverage": coverage,
-                    "new_cells": int(new_cells[agent]),
-                    "action_mask": masks[agent],
+                    "new_cells": new_list[agent],
+                    "action_mask": table.action_mask(),
                     "clusters": clusters,
                     "path": paths[agent],
                     "target": targets[agent],
-                    "position": (int(world.positions[agent, 0]), int(world.positions[agent, 1])),
-                    "travelled": int(world.travelled[agent]),
-                    "padding": bool(padding[agent]),
-                    "oscillation": bool(oscillation[agent]),
+                    "position": tuple(positions[agent]),
+                    "travelled": travelled[agent],
+                    "padding": padding_list[agent],
+                    "oscillation": oscillation_list[agent],
                     "step": self.steps,
                     "end_reason": reason,
                 }

@@ -137,6 +137,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
     return {
         "centroid": enc.centroid,
         "info_gain": enc.info_gain,
+        "gain": cfg.gain,
         "agent_position": enc.agent_position,
         "action_mask": enc.action_mask,
         "sort_by_distance": cfg.observation.sort_by_distance,

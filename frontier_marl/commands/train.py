@@ -127,7 +127,8 @@ def run(args: argparse.Namespace) -> int:
         return _fail(str(exc))
     print(
         f"trained {result.steps_this_session} steps in {result.wall_time_s:.1f} s "
-        f"({result.steps_per_second:.0f} steps/s); total {result.num_timesteps} steps"
+        f"({result.steps_per_second:.0f} steps/s; CPU time {result.cpu_time_s:.1f} s); "
+        f"total {result.num_timesteps} steps"
     )
     if result.interrupted:
         print(

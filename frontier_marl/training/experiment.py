@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -46,7 +47,13 @@ THESIS_DQN: dict[str, Any] = {
 
 #: DQN arguments the pipeline sets itself (seeding goes through set_random_seed, see DESIGN).
 _RESERVED_DQN = {
-    "policy", "env", "seed", "device", "tensorboard_log", "verbose", "_init_setup_model"
+    "policy",
+    "env",
+    "seed",
+    "device",
+    "tensorboard_log",
+    "verbose",
+    "_init_setup_model",
 }
 
 
@@ -165,6 +172,9 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
             f"unknown or reserved [dqn] key(s) {sorted(bad_dqn)}{where}; "
             f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
         )
+    _check_dqn(dqn, where)
+    if isinstance(dqn.get("train_freq"), list):
+        dqn["train_freq"] = tuple(dqn["train_freq"])  # SB3 wants (n, "step"|"episode")
     experiment = Experiment(
         name=name,
         description=str(data.get("description", "")),
@@ -178,6 +188,48 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     except ValueError as exc:
         raise ValueError(f"[env]{where}: {exc}") from exc
     return experiment
+
+
+#: Ranges of the DQN settings checked before SB3 sees them: key -> (kind, low, high).
+_DQN_RANGES: dict[str, tuple[str, float, float]] = {
+    "learning_rate": ("float", 0.0, math.inf),
+    "exploration_fraction": ("float", 0.0, 1.0),
+    "exploration_initial_eps": ("float", 0.0, 1.0),
+    "exploration_final_eps": ("float", 0.0, 1.0),
+    "gamma": ("float", 0.0, 1.0),
+    "tau": ("float", 0.0, 1.0),
+    "max_grad_norm": ("float", 0.0, math.inf),
+    "batch_size": ("int", 1, math.inf),
+    "buffer_size": ("int", 1, math.inf),
+    "learning_starts": ("int", 0, math.inf),
+    "target_update_interval": ("int", 1, math.inf),
+    "train_freq": ("int", 1, math.inf),
+    "gradient_steps": ("int", -1, math.inf),
+    "n_steps": ("int", 1, math.inf),
+}
+
+
+def _check_dqn(dqn: Mapping[str, Any], where: str) -> None:
+    for key, (kind, low, high) in _DQN_RANGES.items():
+        if key not in dqn:
+            continue
+        value = dqn[key]
+        if kind == "int":
+            ok = isinstance(value, int) and not isinstance(value, bool)
+            if key == "train_freq" and isinstance(value, list | tuple) and len(value) == 2:
+                ok, value = isinstance(value[0], int) and value[1] in ("step", "episode"), value[0]
+            what = "an integer"
+        else:
+            ok = isinstance(value, int | float) and not isinstance(value, bool)
+            ok = ok and math.isfinite(value)
+            what = "a number"
+        if not ok or not low <= value <= high:
+            bounds = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
+            raise ValueError(f"dqn.{key} must be {what} {bounds}, got {dqn[key]!r}{where}")
+    if dqn.get("learning_rate", 1.0) == 0:
+        raise ValueError(f"dqn.learning_rate must be > 0{where}")
+    if dqn.get("gradient_steps", 1) == 0:
+        raise ValueError(f"dqn.gradient_steps must be >= 1 or -1, got 0{where}")
 
 
 def parse_override(text: str) -> tuple[str, str, Any]:

@@ -113,13 +113,16 @@ def check_compatible(
     """Raise :class:`ModelEnvMismatchError` naming every difference between model and env.
 
     Compares the saved observation layout (when there is metadata) field by field, then the
-    observation and action spaces themselves.
+    observation and action spaces themselves. Layout fields that the saved metadata lacks
+    (added to the layout after the model was saved) are not compared.
     """
     problems: list[str] = []
     if meta is not None and "observation_layout" in meta:
         saved = meta["observation_layout"]
         current = describe_layout(cfg)
-        for key in sorted(set(saved) | set(current)):
+        # a key missing from the saved layout was added to the layout after the model was
+        # saved: the model used its default, which the spaces check below still guards
+        for key in sorted(set(saved)):
             if saved.get(key) != current.get(key):
                 problems.append(
                     f"observation layout '{key}': model has {saved.get(key)!r}, "

@@ -32,20 +32,27 @@ from pettingzoo.utils.wrappers import BaseParallelWrapper
 from frontier_marl.envs.parallel import FrontierParallelEnv
 
 TRUNCATED_KEY = "TimeLimit.truncated"
+END_REASON_KEY = "episode_end_reason"
 
 
 class TimeLimitInfo(BaseParallelWrapper):
-    """Adds ``info["TimeLimit.truncated"]`` to agents whose episode was truncated, not ended.
+    """Marks the last step of an episode in each agent's info, in keys that survive SuperSuit.
 
-    The only work on an ordinary step is one ``any()`` over the truncation flags.
+    * ``info["TimeLimit.truncated"] = True`` when the episode was truncated, not terminated;
+    * ``info["episode_end_reason"]``: the env's ``end_reason`` (``threshold``, ``step_limit``,
+      ...). SuperSuit's ``MarkovVectorEnv`` merges the next episode's reset info over the last
+      step's info, so the env's own ``end_reason``/``step`` keys read ``""``/``0`` there.
+
+    The only work on an ordinary step is two ``any()`` over the agents' flags.
     """
 
     def step(self, actions: dict[str, Any]) -> tuple[Any, Any, Any, Any, Any]:
         observations, rewards, terminations, truncations, infos = self.env.step(actions)
-        if any(truncations.values()):
-            for agent, truncated in truncations.items():
-                if truncated and not terminations[agent]:
-                    infos[agent][TRUNCATED_KEY] = True
+        if any(truncations.values()) or any(terminations.values()):
+            for agent, info in infos.items():
+                info[END_REASON_KEY] = info.get("end_reason", "")
+                if truncations[agent] and not terminations[agent]:
+                    info[TRUNCATED_KEY] = True
         return observations, rewards, terminations, truncations, infos
 
 

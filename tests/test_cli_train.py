@@ -1,0 +1,128 @@
+"""``frontier-marl train`` and ``frontier-marl evaluate`` end to end, with tiny budgets."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+pytest.importorskip("supersuit")
+
+from frontier_marl.cli import main  # noqa: E402
+
+TINY_CONFIG = """
+name = "tiny-cli"
+description = "a 10 x 10 smoke test"
+
+[env]
+preset = "thesis-20x20"
+height = 10
+width = 10
+perception_range = 2
+reward = "reward2"
+
+[dqn]
+learning_starts = 100
+
+[train]
+total_timesteps = 800
+checkpoint_every = 400
+eval_episodes = 2
+log_interval = 2
+"""
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    root = tmp_path_factory.mktemp("cli")
+    config = root / "tiny.toml"
+    config.write_text(TINY_CONFIG)
+    run_dir = root / "run"
+    code = main(["train", str(config), "--out", str(run_dir), "--seed", "3", "--no-progress"])
+    assert code == 0
+    return config, run_dir
+
+
+def test_train_command_writes_run_folder(trained: tuple[Path, Path], capsys) -> None:
+    _config, run_dir = trained
+    for name in ("model.zip", "model.json", "evaluation.json", "actions.png",
+                 "learning_curve.png"):
+        assert (run_dir / name).is_file(), name
+    assert list((run_dir / "tb").glob("events.out.tfevents.*"))
+    meta = json.loads((run_dir / "model.json").read_text())
+    assert meta["experiment"]["train"]["seed"] == 3
+    assert meta["num_timesteps"] == 800
+
+
+def test_train_resume_extends_the_run(trained: tuple[Path, Path], tmp_path: Path,
+                                      capsys) -> None:
+    import shutil
+
+    _config, run_dir = trained
+    copy = tmp_path / "run"
+    shutil.copytree(run_dir, copy)
+    code = main(["train", "--resume", str(copy), "--steps", "1000", "--no-progress",
+                 "--set", "train.eval_episodes=1"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "resuming at step 800" in out
+    assert "trained 200 steps" in out
+    assert json.loads((copy / "model.json").read_text())["num_timesteps"] == 1000
+    assert json.loads((copy / "evaluation.json").read_text())["model"]["episodes"] == 1
+
+
+def test_train_refuses_bad_input_cleanly(trained: tuple[Path, Path], tmp_path: Path,
+                                         capsys) -> None:
+    config, run_dir = trained
+    assert main(["train", str(config), "--set", "env.centroid=polar", "--no-progress"]) == 2
+    assert "centroid" in capsys.readouterr().err
+    assert main(["train", str(tmp_path / "missing.toml")]) == 2
+    assert "not found" in capsys.readouterr().err
+    assert main(["train", str(config), "--out", str(run_dir), "--no-progress"]) == 2
+    assert "--resume" in capsys.readouterr().err
+    assert main(["train", "--resume", str(run_dir), "--set", "env.reward=reward1"]) == 2
+    assert "cannot change" in capsys.readouterr().err
+    assert main(["train"]) == 2
+
+
+def test_evaluate_command_reports_and_writes_json(trained: tuple[Path, Path], tmp_path: Path,
+                                                  capsys) -> None:
+    _config, run_dir = trained
+    out_json = tmp_path / "eval.json"
+    plot = tmp_path / "actions.png"
+    code = main(["evaluate", str(run_dir / "model.zip"), "--episodes", "3", "--seed", "5",
+                 "--map-mode", "dynamic", "--json", str(out_json), "--plot", str(plot),
+                 "--no-progress"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "greedy-distance" in out and "degenerate" in out
+    result = json.loads(out_json.read_text())
+    assert result["env_config"]["map_mode"] == "dynamic"
+    assert result["env_config"]["height"] == 10  # the training env, from model.json
+    model, greedy = result["rows"]
+    assert model["seeds"] == greedy["seeds"] == [5, 6, 7]
+    for row in (model, greedy):
+        assert {"mean_reward", "std_reward", "terminations", "action_shares",
+                "degeneracy"} <= set(row)
+        assert sum(row["action_shares"]) == pytest.approx(1.0)
+    assert plot.is_file() and plot.stat().st_size > 0
+
+
+def test_evaluate_refuses_a_mismatched_env(trained: tuple[Path, Path], capsys) -> None:
+    _config, run_dir = trained
+    code = main(["evaluate", str(run_dir), "--episodes", "1", "--no-progress",
+                 "--set", "centroid=relative"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "does not match" in err and "centroid" in err and "Traceback" not in err
+    code = main(["evaluate", str(run_dir), "--episodes", "1", "--no-progress",
+                 "--preset", "thesis-30x30"])
+    assert code == 2
+    assert "height" in capsys.readouterr().err
+
+
+def test_evaluate_missing_model(tmp_path: Path, capsys) -> None:
+    assert main(["evaluate", str(tmp_path / "nothing.zip"), "--no-progress"]) == 2
+    assert "not found" in capsys.readouterr().err
