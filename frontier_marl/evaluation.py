@@ -16,6 +16,18 @@ changes; on dynamic maps each seed also draws a fresh layout. Reported, as in SP
   each level of ``coverage_levels`` (default 0.90 and 0.99), with how many episodes got there;
 * a coverage-versus-cells-travelled curve per episode (see :mod:`frontier_marl.metrics`).
 
+With a team (``n_agents > 1``) the result and its dict also hold the team metrics:
+
+* ``makespan``: the longest single robot path (cells) at the episode's end; robots move at
+  the same time, so this is the time the team took, in cell moves;
+* ``makespan_to_coverage``: the longest single path when coverage first reaches each level
+  (``cells_to_coverage`` stays the team's total cells travelled to that level);
+* ``overlap``: :func:`~frontier_marl.metrics.overlap_ratio` of the robots' ``seen`` masks at
+  the episode's end (sum of the areas each robot perceived / their union - 1; 0 for one
+  robot), when the env exposes its world;
+* ``makespan_curve``: coverage versus the longest single path (coverage versus time), per
+  episode; the row index of both curves is the decision step.
+
 The env may be a dict of keyword arguments for :func:`frontier_marl.parallel_env`, a
 zero-argument factory, or an env instance: a PettingZoo ``ParallelEnv`` or a single-robot
 Gymnasium env (possibly wrapped, e.g. for a learned model). The policy is anything with the
@@ -34,7 +46,14 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.metrics import action_shares, cells_to_coverage, coverage_curve, mean_std
+from frontier_marl.metrics import (
+    action_shares,
+    cells_to_coverage,
+    coverage_curve,
+    makespan_curve,
+    mean_std,
+    overlap_ratio,
+)
 from frontier_marl.policies import Policy
 
 #: The thesis's heuristic baselines (SPEC section 6): (preset, map mode, policy) -> (mean, std)
@@ -72,6 +91,15 @@ class EpisodeRecord:
     action_counts: list[int]
     cells_to_coverage: dict[str, float | None]  # level_key -> cells travelled, None = never
     curve: np.ndarray  # (L, 2) cells travelled, coverage
+    robot_travelled: list[int] = field(default_factory=list)  # per robot, at the end
+    makespan: int = 0  # longest single robot path at the end
+    makespan_to_coverage: dict[str, float | None] = field(default_factory=dict)
+    overlap: float | None = None  # overlap ratio of the robots' seen masks at the end
+    makespan_curve: np.ndarray | None = None  # (L, 2) longest single path, coverage
+
+    @property
+    def is_team(self) -> bool:
+        return len(self.robot_travelled) > 1
 
     @property
     def reached_threshold(self) -> bool:
@@ -90,9 +118,33 @@ class EpisodeRecord:
             "action_counts": list(self.action_counts),
             "cells_to_coverage": dict(self.cells_to_coverage),
         }
+        if self.is_team:
+            out["robot_travelled"] = list(self.robot_travelled)
+            out["makespan"] = self.makespan
+            out["makespan_to_coverage"] = dict(self.makespan_to_coverage)
+            out["overlap"] = self.overlap
         if curve:
-            out["curve"] = [[int(t), round(float(c), 6)] for t, c in self.curve]
+            out["curve"] = _curve_list(self.curve)
+            if self.is_team and self.makespan_curve is not None:
+                out["makespan_curve"] = _curve_list(self.makespan_curve)
         return out
+
+
+def _curve_list(curve: np.ndarray) -> list[list[float]]:
+    return [[int(t), round(float(c), 6)] for t, c in curve]
+
+
+def _level_stats(level: float, values: list[float | None]) -> dict[str, Any]:
+    """Episodes that reached ``level`` and the mean/std of ``values`` over those."""
+    reached = [v for v in values if v is not None]
+    mean, std = mean_std(reached)
+    return {
+        "level": level,
+        "reached": len(reached),
+        "mean": None if not reached else mean,
+        "std": None if not reached else std,
+        "per_episode": values,
+    }
 
 
 @dataclass
@@ -149,15 +201,27 @@ class EvaluationResult:
     def cells_to(self, level: float) -> dict[str, Any]:
         """Cells travelled to reach ``level``: episodes that got there, mean/std over those."""
         key = level_key(level)
-        values = [e.cells_to_coverage.get(key) for e in self.episodes]
-        reached = [v for v in values if v is not None]
-        mean, std = mean_std(reached)
+        return _level_stats(level, [e.cells_to_coverage.get(key) for e in self.episodes])
+
+    def makespan_to(self, level: float) -> dict[str, Any]:
+        """Longest single robot path when coverage first reaches ``level`` (as
+        :meth:`cells_to`)."""
+        key = level_key(level)
+        return _level_stats(level, [e.makespan_to_coverage.get(key) for e in self.episodes])
+
+    def team_summary(self) -> dict[str, Any]:
+        """The team metrics of :meth:`to_dict` (makespan, makespan to each level, overlap)."""
+        makespan_mean, makespan_std = self.stat("makespan")
+        overlaps = [e.overlap for e in self.episodes if e.overlap is not None]
+        overlap_mean, overlap_std = mean_std(overlaps)
         return {
-            "level": level,
-            "reached": len(reached),
-            "mean": None if not reached else mean,
-            "std": None if not reached else std,
-            "per_episode": values,
+            "mean_makespan": makespan_mean,
+            "std_makespan": makespan_std,
+            "makespan_to_coverage": {
+                level_key(level): self.makespan_to(level) for level in self.coverage_levels
+            },
+            "mean_overlap": overlap_mean if overlaps else None,
+            "std_overlap": overlap_std if overlaps else None,
         }
 
     def to_dict(self, curves: bool = True) -> dict[str, Any]:
@@ -189,6 +253,7 @@ class EvaluationResult:
             "cells_to_coverage": {
                 level_key(level): self.cells_to(level) for level in self.coverage_levels
             },
+            **(self.team_summary() if self.n_agents > 1 else {}),
             "config": self.config,
             **self.extra,
             "per_episode": [e.to_dict(curve=curves) for e in self.episodes],
@@ -233,6 +298,16 @@ class _TeamView:
         done = all(terminations[a] or truncations[a] for a in rewards) or not self.env.agents
         return obs, rewards, done, infos
 
+    def seen(self) -> np.ndarray | None:
+        """The robots' (N, H, W) ``seen`` masks, or ``None`` if the env hides its world."""
+        unwrapped = getattr(self.env, "unwrapped", self.env)
+        try:
+            world = unwrapped.world
+        except (AttributeError, RuntimeError):
+            return None
+        seen = getattr(world, "seen", None)
+        return None if seen is None else np.asarray(seen)
+
 
 def _config_of(env: Any) -> Any:
     for candidate in (env, getattr(env, "unwrapped", None)):
@@ -272,7 +347,7 @@ def run_episode(
     agents = list(observations)
     returns = dict.fromkeys(agents, 0.0)
     counts = np.zeros(view.n_slots, dtype=np.int64)
-    travelled = [sum(int(infos[a]["travelled"]) for a in agents)]
+    robot_travelled = [[int(infos[a]["travelled"]) for a in agents]]
     coverage = [float(infos[agents[0]]["coverage"])]
     steps = 0
     done = False
@@ -286,11 +361,15 @@ def run_episode(
         for agent in agents:
             returns[agent] += float(rewards[agent])
         steps += 1
-        travelled.append(sum(int(infos[a]["travelled"]) for a in agents))
+        robot_travelled.append([int(infos[a]["travelled"]) for a in agents])
         coverage.append(float(infos[agents[0]]["coverage"]))
     last = infos[agents[0]]
+    per_robot = np.asarray(robot_travelled, dtype=np.int64)
+    travelled = per_robot.sum(axis=1).tolist()
     curve = coverage_curve(travelled, coverage)
+    time_curve = makespan_curve(per_robot, coverage)
     robot_rewards = [returns[a] for a in agents]
+    seen = view.seen()
     return EpisodeRecord(
         seed=seed,
         reward=float(np.mean(robot_rewards)),
@@ -305,6 +384,13 @@ def run_episode(
             level_key(level): cells_to_coverage(curve, level) for level in coverage_levels
         },
         curve=curve,
+        robot_travelled=per_robot[-1].tolist(),
+        makespan=int(per_robot[-1].max()),
+        makespan_to_coverage={
+            level_key(level): cells_to_coverage(time_curve, level) for level in coverage_levels
+        },
+        overlap=None if seen is None else overlap_ratio(seen),
+        makespan_curve=time_curve,
     )
 
 

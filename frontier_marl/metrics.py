@@ -3,6 +3,9 @@
 A *coverage curve* is an ``(L, 2)`` float array of ``(cells travelled, coverage)`` points in
 step order: the team's total travelled cells and the fraction of the reachable free region
 known, recorded at reset and after every decision step. Both columns never decrease.
+A *makespan curve* has the same form with the longest single robot path in the first column
+(the team's elapsed time in cell moves, since robots move at the same time); the same
+functions (:func:`cells_to_coverage`, :func:`mean_curve`) apply to it.
 """
 
 from __future__ import annotations
@@ -22,6 +25,18 @@ def coverage_curve(travelled: Sequence[float], coverage: Sequence[float]) -> np.
             f"{travelled_arr.shape} and {coverage_arr.shape}"
         )
     return np.stack([travelled_arr, coverage_arr], axis=1)
+
+
+def makespan_curve(robot_travelled: np.ndarray, coverage: Sequence[float]) -> np.ndarray:
+    """Coverage versus the longest single robot path so far (coverage versus time: robots move
+    at the same time, one cell per move).
+
+    ``robot_travelled`` is ``(L, N)``: each robot's travelled cells at each recorded point.
+    """
+    per_robot = np.asarray(robot_travelled, dtype=float)
+    if per_robot.ndim != 2 or per_robot.shape[1] == 0:
+        raise ValueError(f"robot_travelled must have shape (L, N >= 1), got {per_robot.shape}")
+    return coverage_curve(per_robot.max(axis=1), coverage)
 
 
 def _check_curve(curve: np.ndarray) -> np.ndarray:

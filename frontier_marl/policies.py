@@ -24,6 +24,33 @@ gain and distance per live slot; ``action_mask``; ``position``), never hidden en
   evaluation.evaluate` attaches the env automatically.
 * ``random``: uniform over the valid slots of ``action_mask``, from its own seeded generator.
 
+Two *joint* heuristics decide for the whole team at once (:meth:`Policy.act_team`). They read
+each robot's ``clusters`` and ``position`` and the shared belief (from ``info["belief"]`` or the
+attached env, as ``cost-utility``). Clusters are matched across robots by their ``cluster``
+index, which is the same for every robot because the belief is shared. Path costs are
+4-connected shortest path lengths over the known-free cells (what A* returns), one BFS per
+robot per step.
+
+* ``coordinated-assignment``: an optimal assignment of robots to distinct clusters
+  (``scipy.optimize.linear_sum_assignment`` on the robots x clusters path-cost matrix, a robot
+  being able to take only the clusters in its own slots). Among all assignments it first
+  maximises the number of robots that get a cluster of their own (pairs a robot cannot take
+  cost more than every feasible assignment together), then minimises the summed path length.
+  A robot left without a cluster (the team has more robots than distinct clusters it can
+  reach) takes its nearest cluster by path: a duplicate, but only where every cluster it
+  could take is already taken. With one robot: its nearest cluster by path length.
+* ``utility-discount``: the coordination of Burgard et al. (2005, IEEE T-RO 21(3)). Every
+  cluster's target t starts with utility ``U_t = 1``; the cost of robot i for t is its path
+  length normalised by the largest path length of any robot to any of its clusters,
+  ``V_it = L_it / max L`` (in [0, 1]). Robots are served one at a time: the pair (i, t) with
+  the largest ``U_t - beta * V_it`` (over robots still without a target and their own slots;
+  ties: smaller path, then agent order, then slot) is fixed, then every target t' loses
+  ``P(||t - t'||)`` of its utility, ``P(d) = max(0, 1 - d / r)`` (a linear visibility
+  probability, Euclidean distance between target cells, ``r`` the sensor range: the env's
+  ``perception_range`` or ``sensor_range=``). ``beta = 1``. A claimed target drops to utility
+  0 for the others, so duplicates are discouraged but not forbidden. With one robot: its
+  nearest cluster by path length, as ``coordinated-assignment``.
+
 With no live cluster every heuristic returns slot 0 (the env's idle action).
 
 Learned models plug in through :class:`CallablePolicy` (any ``obs -> action`` callable) or
@@ -32,7 +59,7 @@ Learned models plug in through :class:`CallablePolicy` (any ``obs -> action`` ca
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -214,6 +241,227 @@ class RandomValid(HeuristicPolicy):
         return int(valid[self._rng.integers(len(valid))])
 
 
+def path_length_fields(passable: np.ndarray, sources: Sequence[tuple[int, int]]) -> np.ndarray:
+    """(len(sources), H, W) 4-connected shortest path lengths from each source over the
+    ``passable`` cells; -1 where unreachable (the same numbers as BFS / A*, computed in C)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    passable = np.asarray(passable, dtype=bool)
+    height, width = passable.shape
+    index = np.arange(height * width).reshape(height, width)
+    across = passable[:, :-1] & passable[:, 1:]
+    down = passable[:-1, :] & passable[1:, :]
+    rows = np.concatenate([index[:, :-1][across], index[:-1, :][down]])
+    cols = np.concatenate([index[:, 1:][across], index[1:, :][down]])
+    graph = csr_matrix(
+        (np.ones(len(rows)), (rows, cols)), shape=(height * width, height * width)
+    )
+    starts = [int(r) * width + int(c) for r, c in sources]
+    if not starts:
+        return np.zeros((0, height, width), dtype=np.int64)
+    dist = dijkstra(graph, directed=False, indices=starts, unweighted=True)
+    dist = np.atleast_2d(dist)
+    return np.where(np.isfinite(dist), dist, -1).astype(np.int64).reshape(-1, height, width)
+
+
+class _Option:
+    """One (robot, cluster) pair a joint heuristic may choose."""
+
+    __slots__ = ("agent", "cluster", "slot", "length", "target")
+
+    def __init__(
+        self, agent: int, cluster: int, slot: int, length: int, target: tuple[int, int]
+    ) -> None:
+        self.agent, self.cluster, self.slot = agent, cluster, slot
+        self.length, self.target = length, target
+
+
+class TeamHeuristic(Policy):
+    """Base of the joint heuristics: robots x clusters path lengths on the shared belief.
+
+    The belief comes from ``info["belief"]`` (any robot's info) when present, else from the env
+    given to :meth:`attach`. :meth:`act` treats one robot as a team of one.
+    """
+
+    def __init__(self) -> None:
+        self._world_source: Callable[[], Any] | None = None
+        self._config: Any = None
+
+    def attach(self, env: Any) -> None:
+        unwrapped = getattr(env, "unwrapped", env)
+        if "world" not in dir(unwrapped):  # dir(): the property raises before reset()
+            raise ValueError(
+                f"{self.name} needs an env with a .world (the robots' map); got {type(env)}"
+            )
+        self._world_source = lambda: unwrapped.world
+        self._config = getattr(unwrapped, "config", None)
+
+    def _belief(self, infos: Sequence[Info]) -> np.ndarray:
+        for info in infos:
+            if "belief" in info:
+                return np.asarray(info["belief"])
+        if self._world_source is None:
+            raise ValueError(
+                f"{self.name} needs the robots' map: put it in info['belief'] "
+                "or call policy.attach(env) first"
+            )
+        return np.asarray(self._world_source().belief)
+
+    def options(self, infos: Sequence[Info]) -> list[list[_Option]]:
+        """Per robot (in the given order), its live clusters with their path lengths;
+        clusters with no known-free path (never the case for the env's live slots) are left
+        out."""
+        per_agent = [_clusters(info) for info in infos]
+        if not any(per_agent):
+            return [[] for _ in infos]
+        belief = self._belief(infos)
+        positions = [tuple(int(v) for v in info["position"]) for info in infos]
+        fields = path_length_fields(belief == FREE, positions)
+        out = []
+        for agent, clusters in enumerate(per_agent):
+            mine = []
+            for c in clusters:
+                row, col = (int(v) for v in c["target"])
+                length = int(fields[agent, row, col])
+                if length >= 0:
+                    mine.append(
+                        _Option(agent, int(c["cluster"]), int(c["slot"]), length, (row, col))
+                    )
+            out.append(mine)
+        return out
+
+    def act(self, obs: Any, info: Info) -> int:
+        return self.act_team({"robot_0": obs}, {"robot_0": info})["robot_0"]
+
+    def act_team(
+        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
+    ) -> dict[str, int]:
+        agents = list(observations)
+        options = self.options([infos[agent] for agent in agents])
+        chosen = self.choose_team(options)
+        return {
+            agent: (0 if pick is None else pick.slot)
+            for agent, pick in zip(agents, chosen, strict=True)
+        }
+
+    def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
+        """One option (or ``None``: idle on slot 0) per robot."""
+        raise NotImplementedError
+
+
+def _nearest(options: Sequence[_Option]) -> _Option | None:
+    """The option with the shortest path (ties: lowest slot)."""
+    return min(options, key=lambda o: (o.length, o.slot), default=None)
+
+
+class CoordinatedAssignment(TeamHeuristic):
+    """Robots to distinct clusters by ``linear_sum_assignment`` on path lengths (see the
+    module docstring for the rule)."""
+
+    name = "coordinated-assignment"
+
+    def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
+        from scipy.optimize import linear_sum_assignment
+
+        n = len(options)
+        if n == 1:
+            return [_nearest(options[0])]
+        clusters = sorted({o.cluster for mine in options for o in mine})
+        if not clusters:
+            return [None] * n
+        column = {cluster: j for j, cluster in enumerate(clusters)}
+        lengths = [o.length for mine in options for o in mine]
+        # A pair a robot cannot take costs more than any whole feasible assignment, so the
+        # solver first maximises the number of feasible pairs, then minimises their sum.
+        forbidden = float(sum(lengths) + 1)
+        cost = np.full((n, len(clusters)), forbidden)
+        by_pair: dict[tuple[int, int], _Option] = {}
+        for agent, mine in enumerate(options):
+            for o in mine:
+                j = column[o.cluster]
+                if o.length < cost[agent, j]:
+                    cost[agent, j] = o.length
+                    by_pair[(agent, j)] = o
+        rows, cols = linear_sum_assignment(cost)
+        chosen: list[_Option | None] = [None] * n
+        for agent, j in zip(rows.tolist(), cols.tolist(), strict=True):
+            chosen[agent] = by_pair.get((agent, j))
+        for agent in range(n):
+            if chosen[agent] is None:  # every cluster it can reach is taken: share the nearest
+                chosen[agent] = _nearest(options[agent])
+        return chosen
+
+
+class UtilityDiscount(TeamHeuristic):
+    """Burgard et al. (2005): sequential choice of ``argmax U_t - beta * V_it``, each claimed
+    target discounting the utility of the targets within sensor range of it (see the module
+    docstring for the formula).
+
+    Args:
+        beta: weight of the normalised path cost against the utility (Burgard's beta).
+        sensor_range: ``r`` of the visibility probability; ``None`` takes the attached env's
+            ``perception_range``.
+    """
+
+    name = "utility-discount"
+
+    def __init__(self, beta: float = 1.0, sensor_range: float | None = None) -> None:
+        super().__init__()
+        if not np.isfinite(beta) or beta < 0:
+            raise ValueError(f"beta must be a finite number >= 0, got {beta!r}")
+        if sensor_range is not None and not (np.isfinite(sensor_range) and sensor_range > 0):
+            raise ValueError(f"sensor_range must be a number > 0 or None, got {sensor_range!r}")
+        self.beta = float(beta)
+        self.sensor_range = sensor_range
+
+    def _range(self) -> float:
+        if self.sensor_range is not None:
+            return float(self.sensor_range)
+        if self._config is not None:
+            return float(self._config.perception_range)
+        raise ValueError(
+            "utility-discount needs a sensor range: pass sensor_range= or attach(env) first"
+        )
+
+    @staticmethod
+    def visibility(distance: np.ndarray | float, sensor_range: float) -> np.ndarray:
+        """``P(d) = max(0, 1 - d / r)``: the share of a target's utility removed by a claim
+        at distance ``d``."""
+        return np.clip(1.0 - np.asarray(distance, dtype=float) / sensor_range, 0.0, None)
+
+    def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
+        n = len(options)
+        flat = [o for mine in options for o in mine]
+        chosen: list[_Option | None] = [None] * n
+        if not flat:
+            return chosen
+        if n == 1:
+            return [_nearest(options[0])]
+        sensor_range = self._range()
+        scale = float(max(max(o.length for o in flat), 1))
+        targets: dict[int, tuple[int, int]] = {o.cluster: o.target for o in flat}
+        utility = dict.fromkeys(targets, 1.0)
+        waiting = {agent for agent in range(n) if options[agent]}
+        while waiting:
+            best = max(
+                (o for agent in waiting for o in options[agent]),
+                key=lambda o: (
+                    utility[o.cluster] - self.beta * o.length / scale,
+                    -o.length,
+                    -o.agent,
+                    -o.slot,
+                ),
+            )
+            chosen[best.agent] = best
+            waiting.discard(best.agent)
+            claimed = np.asarray(best.target, dtype=float)
+            for cluster, target in targets.items():
+                distance = float(np.hypot(*(np.asarray(target, dtype=float) - claimed)))
+                utility[cluster] -= float(self.visibility(distance, sensor_range))
+        return chosen
+
+
 class CallablePolicy(Policy):
     """Wraps any ``obs -> action`` callable (e.g. a trained network) as a :class:`Policy`."""
 
@@ -248,15 +496,20 @@ def _as_slot(action: Any) -> int:
 
 
 #: Heuristic name (as used on the command line) -> class.
-POLICIES: dict[str, type[HeuristicPolicy]] = {
+POLICIES: dict[str, type[Policy]] = {
     "greedy-distance": GreedyDistance,
     "greedy-gain": GreedyGain,
     "cost-utility": CostUtility,
     "random": RandomValid,
+    "coordinated-assignment": CoordinatedAssignment,
+    "utility-discount": UtilityDiscount,
 }
 
+#: The heuristics that decide for the whole team jointly.
+TEAM_POLICIES: tuple[str, ...] = ("coordinated-assignment", "utility-discount")
 
-def make_policy(name: str, seed: int | None = None) -> HeuristicPolicy:
+
+def make_policy(name: str, seed: int | None = None) -> Policy:
     """A fresh heuristic by name; ``seed`` seeds the random policy (ignored by the others)."""
     if name not in POLICIES:
         raise ValueError(f"policy must be one of {list(POLICIES)}, got {name!r}")

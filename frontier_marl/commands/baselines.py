@@ -6,7 +6,11 @@ Example::
         --json baselines.json --plot baselines.png --set cells_per_step=full
 
 Prints a table (the thesis's figures beside ours where SPEC gives them), and optionally writes
-the rows as JSON and a PNG figure. Also home of the env options shared with ``gif``.
+the rows as JSON and a PNG figure. With ``--agents N > 1`` the table and JSON also hold the team
+metrics (makespan to 90 % / 99 % coverage, overlap; see :mod:`frontier_marl.evaluation`), and
+the joint heuristics ``coordinated-assignment`` and ``utility-discount`` are worth naming in
+``--policies``. Maps: ``--map FILE_OR_NAME`` (e.g. ``--map rooms-64``) or
+``--map-generator rooms``. Also home of the env options shared with ``gif``.
 """
 
 from __future__ import annotations
@@ -78,9 +82,18 @@ def parse_set_options(items: Sequence[str] | None) -> dict[str, Any]:
 
 
 def add_env_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--preset --map-mode --seed --agents --set`` (shared by ``baselines`` and ``gif``)."""
+    """``--preset --map --map-generator --map-mode --seed --agents --set`` (shared by
+    ``baselines`` and ``gif``)."""
     parser.add_argument("--preset", choices=sorted(PRESETS), default="thesis-20x20",
                         help="thesis geometry (default: %(default)s)")
+    from frontier_marl.example_maps import example_map_names
+
+    parser.add_argument("--map", default=None, metavar="PATH",
+                        help="load the layout from a .txt, .pgm or .png file, or name an "
+                        f"example map ({', '.join(example_map_names())}); the file sets the "
+                        "size and the map is static")
+    parser.add_argument("--map-generator", choices=["random", "rooms"], default=None,
+                        help="random obstacles or rooms and corridors (default: the preset's)")
     parser.add_argument("--map-mode", choices=["static", "dynamic"], default=None,
                         help="static: one layout from the config's map_seed; dynamic: a new "
                         "layout per episode (default: the preset's)")
@@ -104,6 +117,18 @@ def env_kwargs_from_args(args: argparse.Namespace) -> dict[str, Any]:
         if reserved in overrides:
             raise ValueError(f"--set {reserved}=... is not allowed; use the dedicated option")
     kwargs.update(overrides)
+    map_file = getattr(args, "map", None)
+    generator = getattr(args, "map_generator", None)
+    if map_file is not None:
+        from frontier_marl.example_maps import resolve_map
+
+        if generator is not None:
+            raise ValueError("--map and --map-generator exclude each other (a file is the map)")
+        if "map_path" in overrides:
+            raise ValueError("give the map file once: --map or --set map_path=..., not both")
+        kwargs["map_path"] = resolve_map(map_file)
+    if generator is not None:
+        kwargs["map_generator"] = generator
     if args.map_mode is not None:
         kwargs["map_mode"] = args.map_mode
     kwargs["n_agents"] = args.agents
@@ -162,8 +187,12 @@ def run_baselines(
     preset = str(env_kwargs.get("preset", "thesis-20x20"))
     # The thesis's figures are shown for its geometry (size, range) with one robot only.
     base = make_config(preset)
-    comparable = cfg.n_agents == 1 and (cfg.height, cfg.width, cfg.perception_range) == (
-        base.height, base.width, base.perception_range
+    comparable = (
+        cfg.n_agents == 1
+        and cfg.map_path is None
+        and cfg.map_generator == base.map_generator
+        and (cfg.height, cfg.width, cfg.perception_range)
+        == (base.height, base.width, base.perception_range)
     )
     rows = []
     with tqdm(total=episodes * len(policies), disable=not progress, unit="ep",
@@ -189,11 +218,21 @@ def _fmt_cells(entry: dict[str, Any], episodes: int) -> str:
     return f"{entry['mean']:.1f} ({entry['reached']}/{episodes})"
 
 
+def _fmt_mean_std(mean: float | None, std: float | None, digits: int = 1) -> str:
+    if mean is None:
+        return "—"
+    return f"{mean:.{digits}f} ± {std:.{digits}f}"
+
+
 def format_table(rows: Sequence[dict[str, Any]]) -> str:
-    """The results as a plain-text table."""
+    """The results as a plain-text table; with a team (``n_agents > 1``) also the makespan
+    (longest single robot path) at the end and to each coverage level, and the overlap."""
     header = ["policy", "reward", "thesis", "term.", "steps", "travelled"]
     levels = list(rows[0]["cells_to_coverage"]) if rows else []
+    team = any(row.get("n_agents", 1) > 1 for row in rows)
     header += [f"cells→{float(key):.0%}" for key in levels]
+    if team:
+        header += ["makespan", *(f"makespan→{float(key):.0%}" for key in levels), "overlap"]
     header.append("action shares")
     lines = [header]
     for row in rows:
@@ -203,6 +242,13 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
             else f"{row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
         )
         cells = [_fmt_cells(row["cells_to_coverage"][key], n) for key in levels]
+        if team:
+            spans = row.get("makespan_to_coverage", {})
+            cells += [
+                _fmt_mean_std(row.get("mean_makespan"), row.get("std_makespan")),
+                *(_fmt_cells(spans[key], n) if key in spans else "—" for key in levels),
+                _fmt_mean_std(row.get("mean_overlap"), row.get("std_overlap"), 3),
+            ]
         shares = " ".join(f"{s:.2f}" for s in row["action_shares"])
         lines.append([
             row["policy"],
@@ -227,7 +273,12 @@ def _describe(env_kwargs: dict[str, Any], episodes: int, seed: int) -> str:
     from frontier_marl.config import make_config
 
     cfg = make_config(**env_kwargs)
-    layout = f"map_seed={cfg.map_seed}" if cfg.map_mode == "static" else "fresh layout per seed"
+    if cfg.map_path is not None:
+        layout = f"file {Path(cfg.map_path).name}"
+    elif cfg.map_mode == "static":
+        layout = f"{cfg.map_generator}, map_seed={cfg.map_seed}"
+    else:
+        layout = f"{cfg.map_generator}, fresh layout per seed"
     return (
         f"{env_kwargs.get('preset')} ({cfg.height}x{cfg.width}, r={cfg.perception_range}), "
         f"{cfg.map_mode} map ({layout}), {cfg.n_agents} robot(s), {episodes} episodes, "

@@ -3,7 +3,8 @@
 * ``.txt``: one line per row, ``#`` occupied and ``.`` free; blank lines at the end are ignored.
 * ``.pgm`` (P5 binary or P2 text): a pixel is free when its value is at least 250 (ROS
   map_server's 254), anything darker is occupied, so ROS's "unknown" grey (205) is a wall.
-* ``.png``: same rule on the grey level (the mean of the colour channels).
+* ``.png``: same rule on the grey level (the mean of the colour channels), scaled to 0..255
+  whatever the bit depth.
 
 Every loader returns a bool array, True = occupied, and rejects malformed files with a
 ``ValueError`` that names the file and what is wrong.
@@ -103,15 +104,18 @@ def parse_pgm(data: bytes, name: str = "<pgm>") -> np.ndarray:
         position += 1  # exactly one whitespace byte after maxval
         dtype = np.dtype(">u2") if maxval > 255 else np.dtype(np.uint8)
         count = width * height
-        pixels = np.frombuffer(data, dtype=dtype, count=-1, offset=position)
-        if pixels.size < count:
-            raise ValueError(f"map {name}: {pixels.size} pixels, expected {width}x{height}")
-        pixels = pixels[:count]
+        available = (len(data) - position) // dtype.itemsize
+        if available < count:
+            raise ValueError(f"map {name}: {available} pixels, expected {width}x{height}")
+        pixels = np.frombuffer(data, dtype=dtype, count=count, offset=position)
     else:
         values = data[position:].split()
         if len(values) < width * height:
             raise ValueError(f"map {name}: {len(values)} pixels, expected {width}x{height}")
-        pixels = np.array([int(v) for v in values[: width * height]])
+        try:
+            pixels = np.array([int(v) for v in values[: width * height]])
+        except ValueError as error:
+            raise ValueError(f"map {name}: a P2 pixel is not an integer ({error})") from error
     levels = pixels.reshape(height, width).astype(np.float64) * (255.0 / maxval)
     return levels < FREE_LEVEL
 
@@ -119,11 +123,15 @@ def parse_pgm(data: bytes, name: str = "<pgm>") -> np.ndarray:
 def _load_png(path: Path) -> np.ndarray:
     import imageio.v3 as iio
 
-    image = np.asarray(iio.imread(path), dtype=np.float64)
-    if image.ndim == 3:
-        image = image[..., :3].mean(axis=2)
-    if image.ndim != 2:
-        raise ValueError(f"map file {path}: expected a 2D image, got shape {image.shape}")
-    if image.max(initial=0) <= 1.0 and image.dtype != np.uint8:
-        image = image * 255.0
-    return image < FREE_LEVEL
+    raw = np.asarray(iio.imread(path))
+    if raw.dtype == bool:
+        levels = raw.astype(np.float64) * 255.0
+    elif np.issubdtype(raw.dtype, np.integer):
+        levels = raw.astype(np.float64) * (255.0 / np.iinfo(raw.dtype).max)
+    else:
+        levels = raw.astype(np.float64) * 255.0  # float images are in [0, 1]
+    if levels.ndim == 3:
+        levels = levels[..., :3].mean(axis=2)
+    if levels.ndim != 2:
+        raise ValueError(f"map file {path}: expected a 2D image, got shape {raw.shape}")
+    return levels < FREE_LEVEL

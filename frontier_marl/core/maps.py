@@ -67,8 +67,14 @@ def rooms_map(
     """
     if height < 5 or width < 5:
         raise ValueError(f"rooms_map needs at least 5x5 cells, got {height}x{width}")
+    if min_room < 1:
+        raise ValueError(f"min_room must be >= 1, got {min_room}")
+    if corridor_width < 1:
+        raise ValueError(f"corridor_width must be >= 1, got {corridor_width}")
     if max_room is None:
         max_room = max(min_room, min(height, width) // 4)
+    if max_room < min_room:
+        raise ValueError(f"max_room must be >= min_room={min_room}, got {max_room}")
     if room_count is None:
         room_count = max(2, (height * width) // ((min_room + max_room) ** 2))
     grid = np.ones((height, width), dtype=bool)
