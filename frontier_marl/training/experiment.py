@@ -281,18 +281,36 @@ def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str]) -> dict[s
     return out
 
 
+def config_folders() -> list[Path]:
+    """Where config names are looked up: ``./training`` and the repository's ``training/``.
+
+    The repository's folder is found from this file (``<repo>/frontier_marl/training/``), so
+    with an editable install (``pip install -e .``) ``config01`` resolves from any working
+    directory. ``training/*.toml`` is the only copy of the configs; a non-editable install
+    does not ship them (pass a TOML path then).
+    """
+    folders = [Path.cwd() / "training", Path(__file__).resolve().parents[2] / "training"]
+    return list(dict.fromkeys(folders))
+
+
 def resolve_config_path(config: str | Path) -> Path:
     """A config file path, or the name of a file in the repository's ``training/`` folder."""
     path = Path(config)
     if path.is_file():
         return path
     candidates = [path.with_suffix(".toml")] if path.suffix != ".toml" else []
-    for folder in (Path.cwd() / "training", Path(__file__).resolve().parents[2] / "training"):
+    folders = config_folders()
+    for folder in folders:
         candidates += [folder / path.name, folder / f"{path.name}.toml"]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    raise ValueError(f"config file {str(config)!r} not found (looked in . and training/)")
+    raise ValueError(
+        f"config file {str(config)!r} not found (looked in ., "
+        f"{', '.join(str(f) for f in folders)}); the configs are the repository's "
+        "training/*.toml: pass a TOML path, or install the package editable from a checkout "
+        "(pip install -e .)"
+    )
 
 
 def load_experiment(config: str | Path, overrides: Iterable[str] = ()) -> Experiment:

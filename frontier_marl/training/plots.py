@@ -98,3 +98,43 @@ def plot_learning_curve(
         fig.savefig(os.fspath(path), dpi=110)
     finally:
         plt.close(fig)
+
+
+def plot_action_comparison(
+    shares: Sequence[float],
+    reference: Sequence[float],
+    path: str | os.PathLike[str],
+    labels: tuple[str, str] = ("ours", "thesis"),
+    title: str | None = None,
+) -> None:
+    """Two bars per slot: our action shares beside a reference (e.g. the thesis's), with the
+    degeneracy threshold."""
+    if not shares:
+        raise ValueError("shares must not be empty")
+    plt = _pyplot()
+    n_slots = max(len(shares), len(reference))
+    x = np.arange(n_slots)
+    ours = np.zeros(n_slots)
+    ours[: len(shares)] = shares
+    ref = np.zeros(n_slots)
+    ref[: len(reference)] = reference
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    try:
+        width = 0.38
+        ax.bar(x - width / 2, ours, width, color="C0", label=labels[0])
+        ax.bar(x + width / 2, ref, width, color="0.75", edgecolor="0.3", hatch="//",
+               label=labels[1])
+        for xs, values in ((x - width / 2, ours), (x + width / 2, ref)):
+            for xi, value in zip(xs, values, strict=True):
+                ax.text(xi, value + 0.01, f"{value:.1%}", ha="center", va="bottom", fontsize=7)
+        ax.axhline(DEGENERACY_THRESHOLD, color="C3", linestyle="--", linewidth=1,
+                   label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})")
+        ax.set_xticks(x, [f"slot {k}" for k in x])
+        ax.set_ylim(0, 1.05)
+        ax.set_ylabel("share of decisions")
+        ax.legend(fontsize=8, loc="upper right")
+        ax.set_title(title or "action shares", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(os.fspath(path), dpi=110)
+    finally:
+        plt.close(fig)

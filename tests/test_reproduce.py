@@ -1,0 +1,150 @@
+"""``frontier-marl reproduce`` end to end with a tiny budget (issue 4, items 5 and 10).
+
+The run starts from a working directory outside the repository, so the config lookup
+(``config01`` -> the repository's ``training/config01.toml``) is exercised as after an editable
+install. Nothing here checks learning quality.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+pytest.importorskip("supersuit")
+
+from frontier_marl.cli import main  # noqa: E402
+from frontier_marl.reproduce import HEURISTICS, reproduce  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+STEPS, EPISODES = 2000, 3
+
+
+@pytest.fixture(scope="module")
+def reproduced(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    elsewhere = tmp_path_factory.mktemp("cwd")
+    out = tmp_path_factory.mktemp("reproduce") / "out"
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(elsewhere)  # not the repository: the config must still be found
+        stdout = io.StringIO()
+        with contextlib.redirect_stdout(stdout):
+            code = main(["reproduce", "--steps", str(STEPS), "--episodes", str(EPISODES),
+                         "--out", str(out), "--seed", "1", "--no-progress"])
+    assert code == 0, stdout.getvalue()
+    return out, stdout.getvalue()
+
+
+def test_reproduce_writes_table_figures_and_run(reproduced: tuple[Path, str]) -> None:
+    out, _stdout = reproduced
+    run_dir = out / "config01_seed1"
+    for name in ("comparison.md", "comparison.json", "comparison_rewards.png",
+                 "comparison_actions.png", "learning_curve.png", "baselines.json"):
+        path = out / name
+        assert path.is_file() and path.stat().st_size > 0, name
+    for name in ("model.zip", "model.json", "evaluation.json", "actions.png"):
+        assert (run_dir / name).is_file(), name
+    assert list((run_dir / "tb").glob("events.out.tfevents.*"))
+
+
+def test_reproduce_json_has_dqn_and_heuristic_rows_with_thesis_figures(
+    reproduced: tuple[Path, str],
+) -> None:
+    out, _stdout = reproduced
+    table = json.loads((out / "comparison.json").read_text())
+    rows = {row["policy"]: row for row in table["rows"]}
+    assert list(rows) == ["DQN config01", *HEURISTICS]
+    dqn = rows["DQN config01"]
+    assert dqn["kind"] == "dqn"
+    assert dqn["episodes"] == EPISODES
+    assert (dqn["thesis_mean"], dqn["thesis_std"]) == (15.55, 2.45)
+    assert (dqn["thesis_terminations"], dqn["thesis_episodes"]) == (25, 30)
+    assert dqn["thesis_action_shares"] == [0.506, 0.254, 0.212, 0.028]
+    assert sum(dqn["action_shares"]) == pytest.approx(1.0)
+    assert isinstance(dqn["degenerate"], bool)
+    assert (rows["greedy-distance"]["thesis_mean"], rows["greedy-distance"]["thesis_std"]) == (
+        16.48, 1.78)
+    assert (rows["greedy-gain"]["thesis_mean"], rows["greedy-gain"]["thesis_std"]) == (
+        15.01, 1.12)
+    assert rows["cost-utility"]["thesis_mean"] is None
+    assert rows["random"]["thesis_mean"] is None
+    for name in HEURISTICS:
+        assert rows[name]["kind"] == "heuristic"
+        assert rows[name]["episodes"] == EPISODES
+    assert table["training"]["steps"] == STEPS
+    assert table["training"]["seed"] == 1
+    assert table["setting"]["map_mode"] == "static"
+    assert table["setting"]["seeds"] == [0, EPISODES - 1]
+    assert set(table["checks"]) == {"max_share_at_most_70pct", "three_actions_above_2pct",
+                                    "mean_at_least_13.1"}
+    assert table["summary"]["config"] == "config01"
+    assert table["summary"]["mean_reward"] == pytest.approx(dqn["mean_reward"])
+
+
+def test_heuristics_ran_on_the_dqn_evaluation_episodes(reproduced: tuple[Path, str]) -> None:
+    """The run's own evaluation (model + greedy-distance) and the baselines used the same
+    env and seeds: greedy-distance (deterministic) gives identical episode rewards."""
+    out, _stdout = reproduced
+    evaluation = json.loads((out / "config01_seed1" / "evaluation.json").read_text())
+    baselines = {row["policy"]: row for row in json.loads((out / "baselines.json").read_text())}
+    greedy = evaluation["heuristics"][0]
+    assert greedy["policy"] == "greedy-distance"
+    assert baselines["greedy-distance"]["seeds"] == evaluation["model"]["seeds"]
+    assert baselines["greedy-distance"]["rewards"] == pytest.approx(greedy["rewards"])
+
+
+def test_reproduce_prints_table_and_summary_with_paths(reproduced: tuple[Path, str]) -> None:
+    out, stdout = reproduced
+    markdown = (out / "comparison.md").read_text()
+    for text in ("15.55 ± 2.45", "16.48 ± 1.78", "15.01 ± 1.12", "25/30",
+                 "50.6/25.4/21.2/2.8 %", "| DQN config01 |", "| random |"):
+        assert text in markdown, text
+        assert text in stdout, text
+    assert "Summary" in stdout
+    assert str(out / "comparison.json") in stdout
+    assert str(out / "comparison_rewards.png") in stdout
+
+
+def test_reproduce_refuses_existing_run_then_resumes(
+    reproduced: tuple[Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import shutil
+
+    out, _stdout = reproduced
+    copy = tmp_path / "out"
+    shutil.copytree(out, copy)
+    args = ["reproduce", "--episodes", "1", "--out", str(copy), "--seed", "1", "--no-progress"]
+    assert main([*args, "--steps", str(STEPS)]) == 2
+    assert "--resume" in capsys.readouterr().err
+    assert main([*args, "--steps", str(STEPS + 400), "--resume"]) == 0
+    assert "resuming at step 2000" in capsys.readouterr().out
+    table = json.loads((copy / "comparison.json").read_text())
+    assert table["training"]["steps"] == STEPS + 400
+    assert all(row["episodes"] == 1 for row in table["rows"])
+    sessions = json.loads((copy / "config01_seed1" / "run.json").read_text())["sessions"]
+    assert [(s["start_step"], s["end_step"]) for s in sessions] == [
+        (0, STEPS), (STEPS, STEPS + 400)]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [({"steps": 0}, "steps"), ({"seed": -1}, "seed"), ({"episodes": 0}, "episodes")],
+)
+def test_reproduce_rejects_bad_input(kwargs: dict, name: str, tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=name):
+        reproduce(tmp_path, progress=False, log=lambda _text: None, **kwargs)
+    assert not any(tmp_path.iterdir())
+
+
+def test_config_names_resolve_from_any_directory(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    from frontier_marl.training.experiment import config_folders, resolve_config_path
+
+    monkeypatch.chdir(tmp_path)
+    assert resolve_config_path("config01") == REPO / "training" / "config01.toml"
+    assert REPO / "training" in config_folders()
+    with pytest.raises(ValueError, match="pip install -e"):
+        resolve_config_path("no-such-config")
