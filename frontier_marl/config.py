@@ -86,10 +86,12 @@ class RewardConfig:
 
     Attributes:
         kind: ``reward1`` (harsh, padding truncates) or ``reward2`` (soft, oscillation penalty).
-        explore_threshold: explored fraction that ends the episode well (open choice).
+        explore_threshold: explored fraction that ends the episode well (open choice;
+            0.85 by calibration, docs/calibration.md).
         threshold_basis: what the fraction counts: ``all`` cells known, ``free`` true-free
             cells known, or ``reachable`` free cells reachable from the start that are known.
-        max_steps: decision steps before truncation with the step-limit penalty (open choice).
+        max_steps: decision steps before truncation with the step-limit penalty (open choice;
+            400, about one step per cell, confirmed by calibration; scales with the area).
         no_progress_limit: consecutive steps without a new cell that truncate the episode.
         oscillation_window: Reward 2 penalises a step whose target differs from the previous
             step's target but equals one of the targets chosen in the ``oscillation_window``
@@ -105,7 +107,7 @@ class RewardConfig:
     """
 
     kind: RewardKind = "reward2"
-    explore_threshold: float = 0.95
+    explore_threshold: float = 0.85
     threshold_basis: ThresholdBasis = "reachable"
     max_steps: int = 400
     no_progress_limit: int = 20
@@ -161,18 +163,21 @@ class EnvConfig:
         n_agents: robots sharing one belief grid (1 = the thesis MDP).
         map_generator: ``random`` (independent obstacles with ``obstacle_prob``) or ``rooms``
             (rectangular rooms joined by corridors; ``obstacle_prob`` is not used).
-        obstacle_prob: probability that a cell is an obstacle (open choice).
+        obstacle_prob: probability that a cell is an obstacle (open choice; 0.1 by
+            calibration against the thesis's 20x20 baselines, docs/calibration.md).
         map_mode: ``static`` (one layout from ``map_seed``) or ``dynamic`` (new layout per reset).
         map_seed: seed of the static layout, recorded so results are comparable across runs.
         map_path: load the (static) layout from a .txt, .pgm or .png file instead of drawing
             it; the file sets ``height`` and ``width``.
         perception_range: sensor range r in cells.
         sensor: ``square`` (Chebyshev window, no occlusion) or ``raycast`` (Euclidean disc with
-            line of sight through free cells). Open choice.
+            line of sight through free cells). Open choice; ``raycast`` by calibration.
         cells_per_step: cells a robot moves per decision, or ``"full"`` to walk the whole path
-            to its target. Open choice.
+            to its target. Open choice; 1 by calibration (``full`` erases the thesis's gap
+            between the two greedy heuristics).
         connectivity: 4 or 8, the neighbourhood used to group frontier cells into clusters.
-        max_cluster_cells: clusters larger than this are split recursively (open choice).
+        max_cluster_cells: clusters larger than this are split recursively (open choice;
+            2r + 2: 8 at r = 3, 12 at r = 5).
         n_slots: N_max, the number of cluster slots (the action space size).
         gain: information gain of a cluster: its ``size`` or the ``unknown`` cells around it.
         observation: see :class:`ObservationConfig`.
@@ -183,12 +188,12 @@ class EnvConfig:
     width: int = 20
     n_agents: int = 1
     map_generator: MapGenerator = "random"
-    obstacle_prob: float = 0.2
+    obstacle_prob: float = 0.1
     map_mode: MapMode = "static"
     map_seed: int = 0
     map_path: str | None = None
     perception_range: int = 3
-    sensor: SensorModel = "square"
+    sensor: SensorModel = "raycast"
     cells_per_step: int | str = 1
     connectivity: int = 8
     max_cluster_cells: int = 8
@@ -255,14 +260,19 @@ class EnvConfig:
         return _apply_overrides(self, overrides)
 
 
-#: Presets. ``thesis-30x30`` changes only size, perception range and the size-scaled limits
-#: (step limit and cluster split size scale with the map side / the perception range).
+#: Presets. ``thesis-20x20`` is the calibrated default (docs/calibration.md). ``thesis-30x30``
+#: is derived from it by rule, not by fitting: size 30x30 and perception range 5 (the thesis's
+#: second geometry), ``max_steps`` proportional to the number of cells (400 * 900 / 400) and
+#: ``max_cluster_cells`` = 2r + 2 (the edge of a sensor window plus one, 8 at r = 3); every
+#: other parameter is unchanged.
 PRESETS: dict[str, dict[str, Any]] = {
     "thesis-20x20": {},
     "thesis-30x30": {
         "height": 30,
         "width": 30,
         "perception_range": 5,
+        "max_steps": 900,
+        "max_cluster_cells": 12,
     },
 }
 

@@ -50,7 +50,7 @@ def corridor(tmp_path: Path) -> str:
 def corridor_env(path: str, **kwargs: Any) -> tuple[Any, dict, dict]:
     """A 2-robot corridor env reset so that the robots stand at (1, 4) and (1, 8)."""
     env = frontier_marl.parallel_env(
-        preset=None, map_path=path, n_agents=2, perception_range=1, **kwargs
+        preset=None, map_path=path, n_agents=2, perception_range=1, sensor="square", **kwargs
     )
     for seed in range(200):
         obs, infos = env.reset(seed=seed)

@@ -27,7 +27,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.commands.baselines import non_negative_int, positive_int
 
     parser.add_argument("model", metavar="MODEL",
-                        help="model.zip, a run folder, or a checkpoint folder")
+                        help="model.zip, a run folder, a checkpoint folder, or a shipped "
+                        "model's name (thesis-config01)")
     parser.add_argument("--episodes", type=positive_int, default=30,
                         help="evaluation episodes (default: %(default)s)")
     parser.add_argument("--map-mode", choices=["static", "dynamic"], default=None,

@@ -41,7 +41,12 @@ class LoadedModel:
 
 
 def resolve_model_path(path: str | Path) -> Path:
-    """``model.zip``, a run folder (its final ``model.zip``), or a checkpoint folder."""
+    """``model.zip``, a run folder (its final ``model.zip``), a checkpoint folder, or the name
+    of a model shipped with the package (:mod:`frontier_marl.pretrained`)."""
+    from frontier_marl.pretrained import PRETRAINED, pretrained_model_dir
+
+    if str(path) in PRETRAINED and not Path(path).exists():
+        path = pretrained_model_dir(str(path))
     path = Path(path)
     if path.is_dir():
         if (path / MODEL_FILE).is_file():

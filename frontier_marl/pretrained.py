@@ -1,0 +1,33 @@
+"""Trained models shipped with the package, usable by name wherever a model path is accepted::
+
+    frontier-marl evaluate thesis-config01
+
+Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with its
+``model.json`` metadata (env config, observation layout, training run). How each was trained is
+in docs/results.md.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+#: name -> one-line description
+PRETRAINED: dict[str, str] = {
+    "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
+    "Reward 2), 1e6 steps on thesis-20x20, seed 0",
+}
+
+
+def pretrained_names() -> list[str]:
+    return list(PRETRAINED)
+
+
+def pretrained_model_dir(name: str) -> Path:
+    """The folder of shipped model ``name``; ``ValueError`` if unknown or missing."""
+    if name not in PRETRAINED:
+        raise ValueError(f"pretrained model must be one of {pretrained_names()}, got {name!r}")
+    folder = resources.files("frontier_marl").joinpath("assets", "models", name)
+    if not isinstance(folder, Path) or not (folder / "model.zip").is_file():
+        raise ValueError(f"pretrained model {name!r} is missing from the installed package")
+    return folder
