@@ -126,3 +126,20 @@ def test_evaluate_refuses_a_mismatched_env(trained: tuple[Path, Path], capsys) -
 def test_evaluate_missing_model(tmp_path: Path, capsys) -> None:
     assert main(["evaluate", str(tmp_path / "nothing.zip"), "--no-progress"]) == 2
     assert "not found" in capsys.readouterr().err
+
+
+def test_evaluate_a_team_with_the_shared_parameter_model(
+    trained: tuple[Path, Path], tmp_path: Path, capsys
+) -> None:
+    _config, run_dir = trained
+    out_json = tmp_path / "team.json"
+    code = main(["evaluate", str(run_dir), "--agents", "3", "--episodes", "2",
+                 "--json", str(out_json), "--no-progress"])
+    assert code == 0
+    result = json.loads(out_json.read_text())
+    assert result["env_config"]["n_agents"] == 3
+    model, _greedy = result["rows"]
+    assert model["n_agents"] == 3
+    # every robot acted every step: decisions = 3 x steps in each episode
+    for episode in model["per_episode"]:
+        assert sum(episode["action_counts"]) == 3 * episode["steps"]

@@ -37,6 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="episode i uses reset seed SEED + i (default: %(default)s)")
     parser.add_argument("--preset", choices=sorted(PRESETS), default=None,
                         help="evaluate on another geometry (default: the training env's)")
+    parser.add_argument("--agents", type=positive_int, default=None,
+                        help="robots sharing the belief; each acts with the shared-parameter "
+                        "model (default: as trained)")
     parser.add_argument("--set", dest="overrides", action="append", default=[],
                         metavar="KEY=VALUE", help="any other env parameter (repeatable)")
     parser.add_argument("--heuristics", default="greedy-distance",
@@ -68,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
         overrides = parse_set_options(args.overrides)
         if args.map_mode is not None:
             overrides["map_mode"] = args.map_mode
+        if args.agents is not None:
+            overrides["n_agents"] = args.agents
         heuristics = parse_policies(args.heuristics) if args.heuristics.strip() else []
         loaded = load_model(args.model)
         cfg = evaluation_env_config(loaded, args.preset, overrides)

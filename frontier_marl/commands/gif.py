@@ -43,26 +43,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def render_frame(env: Any, infos: dict[str, dict[str, Any]], cell_px: int) -> np.ndarray:
     """An RGB frame of ``env``'s current state at ``cell_px`` pixels per cell (the same
     picture as ``env.render()`` in ``rgb_array`` mode, which is fixed at 12 px)."""
-    from frontier_marl.render import render_rgb
+    from frontier_marl.envs.common import frame
 
-    world = env.unwrapped.world
-    clusters = world.clusters()
-    targets = np.full((world.n_agents, 2), -1, dtype=np.int64)
-    paths = []
-    for agent, info in enumerate(infos.values()):
-        paths.append(info["path"])
-        if info.get("target") is not None:
-            targets[agent] = info["target"]
-    return render_rgb(
-        world.true_grid,
-        world.belief,
-        world.positions,
-        cluster_labels=clusters.labels(),
-        centroids=clusters.centroids,
-        paths=paths,
-        targets=targets,
-        cell_px=cell_px,
-    )
+    return frame(env.unwrapped.mdp, list(infos.values()), "rgb_array", cell_px=cell_px)
 
 
 def record_episode(

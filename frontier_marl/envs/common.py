@@ -17,8 +17,14 @@ def check_render_mode(render_mode: str | None) -> None:
         raise ValueError(f"render_mode must be one of {RENDER_MODES} or None, got {render_mode!r}")
 
 
-def frame(mdp: ExplorationMDP, last_infos: list[dict[str, Any]] | None, mode: str) -> Any:
-    """An RGB frame (``rgb_array``/``human``) or a text map (``ansi``) of the current state."""
+def frame(
+    mdp: ExplorationMDP,
+    last_infos: list[dict[str, Any]] | None,
+    mode: str,
+    cell_px: int = 12,
+) -> Any:
+    """An RGB frame (``rgb_array``/``human``, ``cell_px`` pixels per cell) or a text map
+    (``ansi``) of the current state."""
     world = mdp.world
     if world is None:
         raise RuntimeError("render() called before reset()")
@@ -39,6 +45,7 @@ def frame(mdp: ExplorationMDP, last_infos: list[dict[str, Any]] | None, mode: st
         centroids=clusters.centroids,
         paths=paths,
         targets=targets,
+        cell_px=cell_px,
     )
 
 
