@@ -92,7 +92,7 @@ class ExplorationMDP:
         cfg = self.cfg
         true_grid = self.true_grid_for_episode(rng)
         starts = sample_start_cells(largest_free_component(true_grid), cfg.n_agents, rng)
-        self.world = World(true_grid.copy(), starts, self.params)
+        self.world = World(true_grid, starts, self.params)  # World makes it read-only
         self._oscillation = [
             OscillationDetector(cfg.reward.oscillation_window) for _ in range(cfg.n_agents)
         ]

@@ -249,3 +249,20 @@ def test_make_sensor():
     assert isinstance(ray, RaycastSensor) and ray.range == 2
     with pytest.raises(ValueError, match="sensor"):
         make_sensor("lidar", 3)
+
+
+def test_raycast_cache_on_a_read_only_grid_matches_the_cast():
+    rng = np.random.default_rng(7)
+    grid = rng.random((9, 13)) < 0.3
+    frozen = grid.copy()
+    frozen.setflags(write=False)
+    sensor = RaycastSensor(4)
+    for row in range(9):
+        for col in range(13):
+            expected = sensor.visible_cells(grid, (row, col))  # writeable: never cached
+            first = sensor.visible_cells(frozen, (row, col))
+            again = sensor.visible_cells(frozen, (row, col))  # from the cache
+            for got in (first, again):
+                np.testing.assert_array_equal(got[0], expected[0])
+                np.testing.assert_array_equal(got[1], expected[1])
+    assert len(sensor._cache) == 9 * 13

@@ -6,7 +6,7 @@ Both models are idealised (no noise): a perceived cell's belief becomes its true
   seen through walls.
 * :class:`RaycastSensor` — every cell within Euclidean distance ``r`` whose straight line of
   sight from the robot's cell crosses no occupied cell (the occupied cell that blocks a ray is
-  itself seen).
+  itself seen). The visible set of a cell is cached while the grid is one read-only array.
 """
 
 from __future__ import annotations
@@ -70,14 +70,35 @@ class SquareSensor:
 class RaycastSensor:
     """Euclidean disc of radius ``r`` with line-of-sight occlusion by occupied cells."""
 
+    #: Visible sets are cached per cell while the true grid stays the same read-only array
+    #: (a static map), as long as the cache would hold at most this many cell indices.
+    CACHE_LIMIT = 4_000_000
+
     def __init__(self, perception_range: int) -> None:
         self.range = int(perception_range)
         self._offsets, self._between = _rays(self.range)
+        self._cache_grid: np.ndarray | None = None
+        self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
     def visible_cells(
         self, true_grid: np.ndarray, cell: tuple[int, int]
     ) -> tuple[np.ndarray, np.ndarray]:
         """Row and column indices of the cells perceived from ``cell``."""
+        if true_grid.flags.writeable:
+            return self._cast(true_grid, cell)
+        if true_grid is not self._cache_grid:
+            self._cache_grid = true_grid
+            self._cache = {}
+            if len(self._offsets) * true_grid.size > self.CACHE_LIMIT:
+                self._cache_grid = None
+        if self._cache_grid is None:
+            return self._cast(true_grid, cell)
+        found = self._cache.get(cell)
+        if found is None:
+            found = self._cache[cell] = self._cast(true_grid, cell)
+        return found
+
+    def _cast(self, true_grid: np.ndarray, cell: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
         height, width = true_grid.shape
         rows = self._offsets[:, 0] + cell[0]
         cols = self._offsets[:, 1] + cell[1]

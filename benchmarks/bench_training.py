@@ -1,7 +1,7 @@
 """Training speed benchmark: steps per second and where the time goes.
 
-    python training/benchmark.py                       # config01, 20 000 steps
-    python training/benchmark.py config04 --steps 50000 --json speed.json
+    python benchmarks/bench_training.py                       # config01, 20 000 steps
+    python benchmarks/bench_training.py config04 --steps 50000 --json speed.json
 
 Runs the real training loop (``frontier_marl.training.train.train``, no evaluation, no
 checkpoints) and times, inside it, the env (the FrontierParallelEnv step itself), the SuperSuit
