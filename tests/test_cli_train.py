@@ -143,3 +143,15 @@ def test_evaluate_a_team_with_the_shared_parameter_model(
     # every robot acted every step: decisions = 3 x steps in each episode
     for episode in model["per_episode"]:
         assert sum(episode["action_counts"]) == 3 * episode["steps"]
+
+
+def test_evaluate_the_shipped_model_by_name(tmp_path: Path, capsys) -> None:
+    out_json = tmp_path / "shipped.json"
+    code = main(["evaluate", "thesis-config01", "--episodes", "2", "--heuristics", "",
+                 "--json", str(out_json), "--no-progress"])
+    assert code == 0
+    result = json.loads(out_json.read_text())
+    assert result["num_timesteps"] == 1_000_000
+    assert result["env_config"]["height"] == 20
+    (model,) = result["rows"]
+    assert model["episodes"] == 2 and sum(model["action_shares"]) == pytest.approx(1.0)
