@@ -20,7 +20,3 @@ def new_belief(shape: tuple[int, int]) -> np.ndarray:
     """An all-unknown belief grid of ``shape``."""
     return np.full(shape, UNKNOWN, dtype=BELIEF_DTYPE)
 
-
-def in_bounds(shape: tuple[int, int], row: int, col: int) -> bool:
-    """Whether ``(row, col)`` lies inside a grid of ``shape``."""
-    return 0 <= row < shape[0] and 0 <= col < shape[1]

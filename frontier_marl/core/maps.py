@@ -30,15 +30,6 @@ def largest_free_component(true_grid: np.ndarray) -> np.ndarray:
     return labels == (int(np.argmax(sizes)) + 1)
 
 
-def free_component_of(true_grid: np.ndarray, cell: tuple[int, int]) -> np.ndarray:
-    """Bool mask of the 4-connected free component that contains ``cell``."""
-    labels, _ = ndimage.label(~true_grid, structure=FOUR_CONNECTED)
-    label = labels[cell]
-    if label == 0:
-        raise ValueError(f"cell {cell} is occupied")
-    return labels == label
-
-
 def sample_start_cells(region: np.ndarray, count: int, rng: np.random.Generator) -> np.ndarray:
     """``count`` distinct cells drawn uniformly from the True cells of ``region``, as (count, 2)."""
     cells = np.argwhere(region)
