@@ -40,8 +40,10 @@ def main(argv: list[str] | None = None) -> int:
                 stale.append(path)
             continue
         path.write_text(text)
-        print(f"wrote {path}: {height}x{width}, seed {seed}, "
-              f"{np.count_nonzero(~grid)} free cells, {components} free component(s)")
+        print(
+            f"wrote {path}: {height}x{width}, seed {seed}, "
+            f"{np.count_nonzero(~grid)} free cells, {components} free component(s)"
+        )
     for path in stale:
         print(f"stale: {path}", file=sys.stderr)
     return 1 if stale else 0

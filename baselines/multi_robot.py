@@ -99,8 +99,10 @@ def _cell(row: Mapping[str, Any], metric: str, digits: int = 1) -> str:
     kind, _, level = metric.partition("@")
     reached = ""
     if level:
-        table = "cells_to_coverage" if kind == "cells" or row["n_agents"] == 1 else (
-            "makespan_to_coverage"
+        table = (
+            "cells_to_coverage"
+            if kind == "cells" or row["n_agents"] == 1
+            else ("makespan_to_coverage")
         )
         entry = row[table][level]
         if entry["reached"] < row["episodes"]:
@@ -155,10 +157,18 @@ def comparison(rows: Sequence[Mapping[str, Any]], baseline: str = BASELINE) -> l
     for row in rows:
         if row["policy"] == baseline or row["n_agents"] == 1:
             continue
-        base = next(r for r in rows if r["policy"] == baseline
-                    and r["setting"] == row["setting"] and r["n_agents"] == row["n_agents"])
-        entry: dict[str, Any] = {"setting": row["setting"], "n_agents": row["n_agents"],
-                                 "policy": row["policy"]}
+        base = next(
+            r
+            for r in rows
+            if r["policy"] == baseline
+            and r["setting"] == row["setting"]
+            and r["n_agents"] == row["n_agents"]
+        )
+        entry: dict[str, Any] = {
+            "setting": row["setting"],
+            "n_agents": row["n_agents"],
+            "policy": row["policy"],
+        }
         for metric in COMPARED:
             ours, theirs = _per_episode(row, metric), _per_episode(base, metric)
             both = ~np.isnan(ours) & ~np.isnan(theirs)
@@ -190,18 +200,22 @@ def comparison_table(entries: Sequence[Mapping[str, Any]]) -> str:
             if m["ci95"] is not None:
                 change += f" ± {m['ci95']:.1%}"
             cells.append(f"{change} ({m['wins']}/{m['ties']}/{m['losses']})")
-        lines.append(f"| {e['setting']} | {e['n_agents']} | {e['policy']} | "
-                     + " | ".join(cells) + " |")
+        lines.append(
+            f"| {e['setting']} | {e['n_agents']} | {e['policy']} | " + " | ".join(cells) + " |"
+        )
     return "\n".join(lines)
 
 
 def without_curves(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """The rows with the per-episode curves left out (the plots keep them)."""
     return [
-        {**row, "per_episode": [
-            {k: v for k, v in e.items() if k not in ("curve", "makespan_curve")}
-            for e in row["per_episode"]
-        ]}
+        {
+            **row,
+            "per_episode": [
+                {k: v for k, v in e.items() if k not in ("curve", "makespan_curve")}
+                for e in row["per_episode"]
+            ],
+        }
         for row in rows
     ]
 
@@ -212,15 +226,24 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="first reset seed (default: 0)")
     parser.add_argument("--robots", default="1,2,4", help="team sizes (default: 1,2,4)")
     parser.add_argument("--out", type=Path, default=OUT, help="output folder")
-    parser.add_argument("--curves", action="store_true",
-                        help="keep the per-episode coverage curves in results.json (large)")
+    parser.add_argument(
+        "--curves",
+        action="store_true",
+        help="keep the per-episode coverage curves in results.json (large)",
+    )
     args = parser.parse_args(argv)
     robots = [int(n) for n in args.robots.split(",")]
     policies = {name: (lambda name=name: make_policy(name, args.seed)) for name in HEURISTICS}
     start_wall, start_cpu = time.perf_counter(), time.process_time()
     env_settings = settings()
-    rows = run_experiment(env_settings, policies, robots, args.episodes, args.seed,
-                          log=lambda text: print(text, file=sys.stderr))
+    rows = run_experiment(
+        env_settings,
+        policies,
+        robots,
+        args.episodes,
+        args.seed,
+        log=lambda text: print(text, file=sys.stderr),
+    )
     cpu = time.process_time() - start_cpu
     wall = time.perf_counter() - start_wall
     entries = comparison(rows)
@@ -232,17 +255,29 @@ def main(argv: list[str] | None = None) -> int:
     for setting in env_settings:
         chosen = [r for r in rows if r["setting"] == setting]
         plot_team_comparison(
-            chosen, args.out / f"{setting}.png",
+            chosen,
+            args.out / f"{setting}.png",
             title=f"{setting}: {args.episodes} episodes per bar (seeds {args.seed}.."
             f"{args.seed + args.episodes - 1}), explore_threshold=1.0",
         )
-    command = "python baselines/multi_robot.py" + (
-        f" {' '.join(argv)}" if argv else " " + " ".join(sys.argv[1:])
-    ).rstrip()
+    command = (
+        "python baselines/multi_robot.py"
+        + (f" {' '.join(argv)}" if argv else " " + " ".join(sys.argv[1:])).rstrip()
+    )
     from frontier_marl.config import make_config
 
-    shown = ("perception_range", "sensor", "cells_per_step", "n_slots", "max_cluster_cells",
-             "connectivity", "obstacle_prob", "map_seed", *LONG_EPISODES)
+    shown = (
+        "perception_range",
+        "sensor",
+        "cells_per_step",
+        "n_slots",
+        "max_cluster_cells",
+        "connectivity",
+        "obstacle_prob",
+        "map_seed",
+        *LONG_EPISODES,
+    )
+
     def describe(cfg: Any) -> str:
         keys = [k for k in shown if cfg.map_path is None or k not in ("obstacle_prob", "map_seed")]
         parts = [f"{cfg.height}x{cfg.width}"]
@@ -271,8 +306,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     (args.out / "summary.md").write_text(summary)
     print(summary)
-    print(f"wrote {args.out}/results.json, comparison.json, summary.md and "
-          f"{', '.join(f'{s}.png' for s in env_settings)}")
+    print(
+        f"wrote {args.out}/results.json, comparison.json, summary.md and "
+        f"{', '.join(f'{s}.png' for s in env_settings)}"
+    )
     return 0
 
 

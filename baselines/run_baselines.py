@@ -42,9 +42,21 @@ def main(argv: list[str] | None = None) -> int:
     for preset, mode in SETTINGS:
         stem = args.out / f"{preset}-{mode}"
         command = [
-            "baselines", "--preset", preset, "--map-mode", mode,
-            "--episodes", args.episodes, "--seed", args.seed, "--policies", args.policies,
-            "--json", f"{stem}.json", "--plot", f"{stem}.png",
+            "baselines",
+            "--preset",
+            preset,
+            "--map-mode",
+            mode,
+            "--episodes",
+            args.episodes,
+            "--seed",
+            args.seed,
+            "--policies",
+            args.policies,
+            "--json",
+            f"{stem}.json",
+            "--plot",
+            f"{stem}.png",
         ]
         command += [arg for item in args.overrides for arg in ("--set", item)]
         if args.no_progress:

@@ -28,10 +28,21 @@ import frontier_marl
 SETTINGS: list[tuple[str, dict[str, Any]]] = [
     ("thesis-20x20, 1 robot", {"preset": "thesis-20x20"}),
     ("thesis-30x30, 1 robot", {"preset": "thesis-30x30"}),
-    ("64x64, 4 robots", {"preset": "thesis-20x20", "height": 64, "width": 64, "n_agents": 4,
-                         "max_steps": 2000}),
-    ("128x128, 8 robots", {"preset": "thesis-20x20", "height": 128, "width": 128, "n_agents": 8,
-                           "max_steps": 4000, "perception_range": 5}),
+    (
+        "64x64, 4 robots",
+        {"preset": "thesis-20x20", "height": 64, "width": 64, "n_agents": 4, "max_steps": 2000},
+    ),
+    (
+        "128x128, 8 robots",
+        {
+            "preset": "thesis-20x20",
+            "height": 128,
+            "width": 128,
+            "n_agents": 8,
+            "max_steps": 4000,
+            "perception_range": 5,
+        },
+    ),
 ]
 
 
@@ -46,8 +57,12 @@ def explore_bench_settings(map_file: Path) -> list[tuple[str, dict[str, Any]]]:
     step) and ~2.7 steps/s (learning env, one goal per step, moved all the way) on this map and
     machine kind (figures from shared/maps/explore-bench/README.md).
     """
-    common = {"map_path": str(map_file), "perception_range": 35, "max_steps": 100_000,
-              "no_progress_limit": 10_000}
+    common = {
+        "map_path": str(map_file),
+        "perception_range": 35,
+        "max_steps": 100_000,
+        "no_progress_limit": 10_000,
+    }
     return [
         ("room1_modified, 1 cell", {**common, "cells_per_step": 1}),
         ("room1_modified, full", {**common, "cells_per_step": "full"}),
@@ -80,8 +95,12 @@ def decisions_per_second(kwargs: dict[str, Any], policy: Any, seconds: float) ->
             env_time += time.perf_counter() - start
             steps += 1
         episodes += 1
-    return {"decisions_per_s": steps / env_time, "us_per_decision": 1e6 * env_time / steps,
-            "steps": steps, "episodes": episodes}
+    return {
+        "decisions_per_s": steps / env_time,
+        "us_per_decision": 1e6 * env_time / steps,
+        "steps": steps,
+        "episodes": episodes,
+    }
 
 
 def dqn_env_share(steps: int) -> dict[str, float]:
@@ -114,16 +133,30 @@ def dqn_env_share(steps: int) -> dict[str, float]:
     timings = {}
     for name, env in (("null", NullEnv()), ("env", real)):
         model = DQN(
-            "MultiInputPolicy", env, learning_rate=5e-5, exploration_fraction=0.7,
-            exploration_final_eps=0.05, batch_size=64, buffer_size=50_000,
-            target_update_interval=500, train_freq=4, learning_starts=1000, seed=0, verbose=0,
+            "MultiInputPolicy",
+            env,
+            learning_rate=5e-5,
+            exploration_fraction=0.7,
+            exploration_final_eps=0.05,
+            batch_size=64,
+            buffer_size=50_000,
+            target_update_interval=500,
+            train_freq=4,
+            learning_starts=1000,
+            seed=0,
+            verbose=0,
         )
         start = time.perf_counter()
         model.learn(total_timesteps=steps)
         timings[name] = time.perf_counter() - start
     share = (timings["env"] - timings["null"]) / timings["env"]
-    return {"steps": steps, "seconds_null": timings["null"], "seconds_env": timings["env"],
-            "steps_per_s_env": steps / timings["env"], "env_share": share}
+    return {
+        "steps": steps,
+        "seconds_null": timings["null"],
+        "seconds_env": timings["env"],
+        "steps_per_s_env": steps / timings["env"],
+        "env_share": share,
+    }
 
 
 def main() -> None:
@@ -132,28 +165,38 @@ def main() -> None:
     parser.add_argument("--dqn-steps", type=int, default=30_000)
     parser.add_argument("--skip-dqn", action="store_true")
     parser.add_argument("--json", help="write the figures to this file")
-    parser.add_argument("--explore-bench-map", type=Path, default=EXPLORE_BENCH_MAP,
-                        help="Explore-Bench PGM map for the side-by-side figure "
-                        "(skipped if absent)")
+    parser.add_argument(
+        "--explore-bench-map",
+        type=Path,
+        default=EXPLORE_BENCH_MAP,
+        help="Explore-Bench PGM map for the side-by-side figure (skipped if absent)",
+    )
     args = parser.parse_args()
     settings = list(SETTINGS)
     if args.explore_bench_map.is_file():
         settings += explore_bench_settings(args.explore_bench_map)
-    report: dict[str, Any] = {"machine": platform.processor() or platform.machine(),
-                              "python": platform.python_version(), "decisions": []}
+    report: dict[str, Any] = {
+        "machine": platform.processor() or platform.machine(),
+        "python": platform.python_version(),
+        "decisions": [],
+    }
     print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
     for label, kwargs in settings:
         for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
             row = decisions_per_second(kwargs, policy, args.seconds)
             report["decisions"].append({"setting": label, "policy": policy_name, **row})
-            print(f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
-                  f"{row['us_per_decision']:>13.1f}")
+            print(
+                f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
+                f"{row['us_per_decision']:>13.1f}"
+            )
     if not args.skip_dqn:
         dqn = dqn_env_share(args.dqn_steps)
         report["dqn"] = dqn
-        print(f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
-              f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
-              f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} %")
+        print(
+            f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
+            f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
+            f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} %"
+        )
     if args.json:
         with open(args.json, "w") as handle:
             json.dump(report, handle, indent=2)

@@ -59,8 +59,13 @@ def main(argv: list[str] | None = None) -> int:
 
     experiment = load_experiment(
         args.config,
-        [*args.overrides, f"train.total_timesteps={args.steps}", f"train.seed={args.seed}",
-         "train.eval_episodes=0", "train.checkpoint_every=0"],
+        [
+            *args.overrides,
+            f"train.total_timesteps={args.steps}",
+            f"train.seed={args.seed}",
+            "train.eval_episodes=0",
+            "train.checkpoint_every=0",
+        ],
     )
     env_timer, vec_timer, grad_timer = Timer(), Timer(), Timer()
     originals = (FrontierParallelEnv.step, DQN.train, vec_module.make_vec_env)

@@ -120,8 +120,9 @@ def build_grid(
             torch_threads=1,
         )
         run_dir = out / "runs" / experiment.name / f"seed{seed}_steps{steps}"
-        trials.append(TrialSpec(experiment.name, int(seed), int(steps), data, str(run_dir),
-                                eval_episodes))
+        trials.append(
+            TrialSpec(experiment.name, int(seed), int(steps), data, str(run_dir), eval_episodes)
+        )
     return trials
 
 
@@ -150,18 +151,26 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
         if checkpoints:
             checkpoint = checkpoints[-1]
             settings = spec.experiment["train"]
-            experiment = resume_experiment(checkpoint, {
-                key: settings[key] for key in ("total_timesteps", "eval_episodes", "torch_threads")
-            })
+            experiment = resume_experiment(
+                checkpoint,
+                {
+                    key: settings[key]
+                    for key in ("total_timesteps", "eval_episodes", "torch_threads")
+                },
+            )
         result = train(experiment, run_dir, resume=checkpoint, progress_bar=False)
         if result.interrupted or result.evaluation is None:
             raise RuntimeError(
                 f"training of {spec.name} was interrupted at step {result.num_timesteps}"
             )
-        row = summary_row(result.evaluation, config=spec.config, seed=spec.seed,
-                          steps=result.num_timesteps,
-                          wall_time_s=training_wall_time(run_dir) or result.wall_time_s,
-                          run_dir=run_dir)
+        row = summary_row(
+            result.evaluation,
+            config=spec.config,
+            seed=spec.seed,
+            steps=result.num_timesteps,
+            wall_time_s=training_wall_time(run_dir) or result.wall_time_s,
+            run_dir=run_dir,
+        )
         row["reused"] = False
     row["status"] = "ok"
     row["trial_wall_time_s"] = round(time.perf_counter() - started, 2)
@@ -244,9 +253,15 @@ def _row_from_report(report: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
 
 
 def _failed_row(spec: TrialSpec, error: str) -> dict[str, Any]:
-    return {"config": spec.config, "seed": spec.seed, "steps": spec.steps,
-            "episodes": spec.eval_episodes, "run_dir": spec.run_dir, "status": "error",
-            "error": error}
+    return {
+        "config": spec.config,
+        "seed": spec.seed,
+        "steps": spec.steps,
+        "episodes": spec.eval_episodes,
+        "run_dir": spec.run_dir,
+        "status": "error",
+        "error": error,
+    }
 
 
 def run_campaign(
@@ -275,25 +290,32 @@ def run_campaign(
         raise ValueError(f"--cpus-per-trial must be > 0, got {cpus_per_trial!r}")
     if max_concurrent is not None and max_concurrent < 1:
         raise ValueError(f"--max-concurrent must be >= 1, got {max_concurrent!r}")
-    trials = build_grid(configs, seeds, budgets, out, eval_episodes=eval_episodes,
-                        overrides=overrides)
+    trials = build_grid(
+        configs, seeds, budgets, out, eval_episodes=eval_episodes, overrides=overrides
+    )
     out = Path(out).resolve()
     out.mkdir(parents=True, exist_ok=True)
 
     started_ray = False
     if not ray.is_initialized():
         try:
-            ray.init(address=address, include_dashboard=False, log_to_driver=False,
-                     configure_logging=False)
+            ray.init(
+                address=address,
+                include_dashboard=False,
+                log_to_driver=False,
+                configure_logging=False,
+            )
         except ConnectionError as exc:
             raise ValueError(f"--address {address}: cannot connect to Ray: {exc}") from exc
         started_ray = True
     elif address is not None:
         log(f"note: Ray is already initialised; ignoring --address {address}")
     resources = ray.cluster_resources()
-    log(f"campaign: {len(trials)} trial(s) on Ray ({resources.get('CPU', 0):.0f} CPUs"
+    log(
+        f"campaign: {len(trials)} trial(s) on Ray ({resources.get('CPU', 0):.0f} CPUs"
         f"{', ' + address if address else ', local'}), {cpus_per_trial} CPU(s) per trial"
-        f"{f', at most {max_concurrent} at once' if max_concurrent else ''} -> {out}")
+        f"{f', at most {max_concurrent} at once' if max_concurrent else ''} -> {out}"
+    )
 
     started = time.perf_counter()
     try:
@@ -383,8 +405,14 @@ def _progress_callback(tune: Any, trials: Sequence[TrialSpec], progress: bool) -
 
             from tqdm import tqdm
 
-            self.bar = tqdm(total=len(self.names), unit="trial", disable=not self.progress,
-                            file=sys.stderr, dynamic_ncols=True, desc="campaign")
+            self.bar = tqdm(
+                total=len(self.names),
+                unit="trial",
+                disable=not self.progress,
+                file=sys.stderr,
+                dynamic_ncols=True,
+                desc="campaign",
+            )
 
         def _done(self, trial: Any, text: str) -> None:
             import sys
@@ -398,20 +426,20 @@ def _progress_callback(tune: Any, trials: Sequence[TrialSpec], progress: bool) -
                 print(line, flush=True)
             self.bar.update(1)
 
-        def on_trial_complete(self, iteration: int, trials: list, trial: Any, **info: Any
-                              ) -> None:
+        def on_trial_complete(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
             r = trial.last_result or {}
             if "mean_reward" in r:
                 flag = ", DEGENERATE" if r.get("degenerate") else ""
-                text = (f"{r['mean_reward']:.2f} ± {r['std_reward']:.2f}, "
-                        f"{int(r['terminations'])}/{int(r['episodes'])} terminations{flag} "
-                        f"({r.get('trial_wall_time_s', 0):.0f} s)")
+                text = (
+                    f"{r['mean_reward']:.2f} ± {r['std_reward']:.2f}, "
+                    f"{int(r['terminations'])}/{int(r['episodes'])} terminations{flag} "
+                    f"({r.get('trial_wall_time_s', 0):.0f} s)"
+                )
             else:
                 text = "finished without a result"
             self._done(trial, text)
 
-        def on_trial_error(self, iteration: int, trials: list, trial: Any, **info: Any
-                           ) -> None:
+        def on_trial_error(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
             self._done(trial, "FAILED")
 
         def on_experiment_end(self, trials: list, **info: Any) -> None:

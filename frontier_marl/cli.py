@@ -15,8 +15,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "baselines": ("baselines", "evaluate the heuristic baselines with the thesis's protocol"),
     "train": ("train", "train DQN on an experiment config (SB3 through SuperSuit)"),
     "evaluate": ("evaluate", "evaluate a trained model with the thesis's protocol"),
-    "reproduce": ("reproduce", "train configuration 1 and compare it with the heuristics and "
-                  "the thesis"),
+    "reproduce": (
+        "reproduce",
+        "train configuration 1 and compare it with the heuristics and the thesis",
+    ),
     "campaign": ("campaign", "train a grid of configs x seeds x budgets with Ray Tune"),
 }
 

@@ -392,9 +392,7 @@ def _check_finite(name: str, value: Any) -> None:
         raise ValueError(f"{name} must be a finite number, got {value!r}")
 
 
-def _check_range(
-    name: str, value: Any, low: float, high: float, low_open: bool = False
-) -> None:
+def _check_range(name: str, value: Any, low: float, high: float, low_open: bool = False) -> None:
     _check_finite(name, value)
     if (value <= low if low_open else value < low) or value > high:
         bracket = "(" if low_open else "["

@@ -85,9 +85,7 @@ class ExplorationMDP:
             return rooms_map(cfg.height, cfg.width, rng)
         return random_obstacle_map(cfg.height, cfg.width, cfg.obstacle_prob, rng)
 
-    def reset(
-        self, rng: np.random.Generator
-    ) -> tuple[list[Observation], list[dict[str, Any]]]:
+    def reset(self, rng: np.random.Generator) -> tuple[list[Observation], list[dict[str, Any]]]:
         """Start an episode: map, start cells in the largest free component, first sensing."""
         cfg = self.cfg
         true_grid = self.true_grid_for_episode(rng)
@@ -237,7 +235,9 @@ class ExplorationMDP:
         positions = world.positions.tolist()
         travelled = world.travelled.tolist()
         new_list, padding_list, oscillation_list = (
-            new_cells.tolist(), padding.tolist(), oscillation.tolist()
+            new_cells.tolist(),
+            padding.tolist(),
+            oscillation.tolist(),
         )
         infos = []
         for agent, table in enumerate(self._slots):

@@ -85,9 +85,7 @@ class ObservationEncoder:
             per_mate = 4 if self.teammates == "positions+targets" else 2
             cell_high = np.array([height - 1, width - 1]) / self._position_scale
             mate_high = np.tile(cell_high, (cfg.n_agents - 1) * per_mate // 2).astype(np.float32)
-            entries["teammates"] = spaces.Box(
-                np.zeros_like(mate_high), mate_high, dtype=np.float32
-            )
+            entries["teammates"] = spaces.Box(np.zeros_like(mate_high), mate_high, dtype=np.float32)
         self.space = spaces.Dict(entries)
 
     def encode(

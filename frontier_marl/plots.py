@@ -55,8 +55,17 @@ def plot_baselines(
             t_x = [i + offset for i in known]
             t_mean = [float(rows[i]["thesis_mean"]) for i in known]
             t_std = [float(rows[i].get("thesis_std") or 0.0) for i in known]
-            bars.bar(t_x, t_mean, width, yerr=t_std, capsize=4, color="0.75",
-                     edgecolor="0.3", hatch="//", label="thesis")
+            bars.bar(
+                t_x,
+                t_mean,
+                width,
+                yerr=t_std,
+                capsize=4,
+                color="0.75",
+                edgecolor="0.3",
+                hatch="//",
+                label="thesis",
+            )
             bars.legend(loc="best", fontsize=8)
         for i, row in enumerate(rows):
             bars.annotate(
@@ -85,8 +94,12 @@ def plot_baselines(
             grid, mean, std = mean_curve(episode_curves)
             curves.plot(grid, mean, color=colours[i], label=names[i])
             curves.fill_between(
-                grid, np.clip(mean - std, 0, 1), np.clip(mean + std, 0, 1),
-                color=colours[i], alpha=0.18, linewidth=0,
+                grid,
+                np.clip(mean - std, 0, 1),
+                np.clip(mean + std, 0, 1),
+                color=colours[i],
+                alpha=0.18,
+                linewidth=0,
             )
         for level in (0.90, 0.99):
             curves.axhline(level, color="0.6", linestyle=":", linewidth=0.8)
@@ -120,7 +133,10 @@ def _episode_curves(row: Mapping[str, Any], key: str) -> list[np.ndarray]:
 
 
 def _coverage_panel(
-    axis: Any, rows: Sequence[Mapping[str, Any]], key: str, colours: Sequence[str],
+    axis: Any,
+    rows: Sequence[Mapping[str, Any]],
+    key: str,
+    colours: Sequence[str],
     labels: Sequence[str] | None = None,
 ) -> None:
     for i, row in enumerate(rows):
@@ -128,10 +144,17 @@ def _coverage_panel(
         if not episode_curves:
             continue
         grid, mean, std = mean_curve(episode_curves)
-        axis.plot(grid, mean, color=colours[i], label=str(row["policy"]) if labels is None
-                  else labels[i])
-        axis.fill_between(grid, np.clip(mean - std, 0, 1), np.clip(mean + std, 0, 1),
-                          color=colours[i], alpha=0.15, linewidth=0)
+        axis.plot(
+            grid, mean, color=colours[i], label=str(row["policy"]) if labels is None else labels[i]
+        )
+        axis.fill_between(
+            grid,
+            np.clip(mean - std, 0, 1),
+            np.clip(mean + std, 0, 1),
+            color=colours[i],
+            alpha=0.15,
+            linewidth=0,
+        )
     for level in (0.90, 0.99):
         axis.axhline(level, color="0.6", linestyle=":", linewidth=0.8)
     axis.set_ylabel("coverage of the reachable free region")
@@ -192,8 +215,9 @@ def plot_team_comparison(
             for k, name in enumerate(policies):
                 xs, means, stds = [], [], []
                 for i, size in enumerate(sizes):
-                    match = [r for r in rows if r["policy"] == name
-                             and int(r.get("n_agents", 1)) == size]
+                    match = [
+                        r for r in rows if r["policy"] == name and int(r.get("n_agents", 1)) == size
+                    ]
                     if not match:
                         continue
                     mean, std = team_value(match[0], metric)
@@ -202,22 +226,20 @@ def plot_team_comparison(
                     xs.append(i + (k - (len(policies) - 1) / 2) * width)
                     means.append(mean)
                     stds.append(std or 0.0)
-                axis.bar(xs, means, width, yerr=stds, capsize=3, color=colour[name],
-                         label=name)
-            axis.set_xticks(range(len(sizes)), [f"{n} robot{'s' if n > 1 else ''}"
-                                                for n in sizes])
+                axis.bar(xs, means, width, yerr=stds, capsize=3, color=colour[name], label=name)
+            axis.set_xticks(range(len(sizes)), [f"{n} robot{'s' if n > 1 else ''}" for n in sizes])
             axis.set_title(label, fontsize=9)
         axes[0][0].legend(fontsize=7, loc="best")
-        for axis in axes[0][len(metrics):]:
+        for axis in axes[0][len(metrics) :]:
             axis.axis("off")
         for axis, size in zip(axes[1], sizes, strict=False):
             chosen = [r for r in rows if int(r.get("n_agents", 1)) == size]
-            _coverage_panel(axis, chosen, "makespan_curve",
-                            [colour[str(r["policy"])] for r in chosen])
+            _coverage_panel(
+                axis, chosen, "makespan_curve", [colour[str(r["policy"])] for r in chosen]
+            )
             axis.set_xlabel("longest single robot path (cells) = time")
-            axis.set_title(f"coverage vs time, {size} robot{'s' if size > 1 else ''}",
-                           fontsize=9)
-        for axis in axes[1][len(sizes):]:
+            axis.set_title(f"coverage vs time, {size} robot{'s' if size > 1 else ''}", fontsize=9)
+        for axis in axes[1][len(sizes) :]:
             axis.axis("off")
         if title:
             fig.suptitle(title, fontsize=10)

@@ -254,9 +254,7 @@ def path_length_fields(passable: np.ndarray, sources: Sequence[tuple[int, int]])
     down = passable[:-1, :] & passable[1:, :]
     rows = np.concatenate([index[:, :-1][across], index[:-1, :][down]])
     cols = np.concatenate([index[:, 1:][across], index[1:, :][down]])
-    graph = csr_matrix(
-        (np.ones(len(rows)), (rows, cols)), shape=(height * width, height * width)
-    )
+    graph = csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(height * width, height * width))
     starts = [int(r) * width + int(c) for r, c in sources]
     if not starts:
         return np.zeros((0, height, width), dtype=np.int64)

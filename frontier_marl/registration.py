@@ -18,8 +18,6 @@ def register_envs() -> None:
             disable_env_checker=False,
         )
     if PETTINGZOO_ID not in pettingzoo.parallel_registry:
-        pettingzoo.register(
-            "parallel", PETTINGZOO_ID, entry_point="frontier_marl:parallel_env"
-        )
+        pettingzoo.register("parallel", PETTINGZOO_ID, entry_point="frontier_marl:parallel_env")
     if PETTINGZOO_ID not in pettingzoo.aec_registry:
         pettingzoo.register("aec", PETTINGZOO_ID, entry_point="frontier_marl:env")

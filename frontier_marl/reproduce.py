@@ -128,7 +128,8 @@ def _cells(row: Mapping[str, Any]) -> dict[str, str]:
         "ours": _mean_std(row["mean_reward"], row["std_reward"]),
         "thesis": _mean_std(row["thesis_mean"], row["thesis_std"]),
         "terminations": f"{row['terminations']}/{row['episodes']}",
-        "thesis_terminations": "—" if thesis_term is None
+        "thesis_terminations": "—"
+        if thesis_term is None
         else f"{thesis_term}/{row['thesis_episodes']}",
         "action_shares": format_shares(row["action_shares"]),
         "thesis_action_shares": format_shares(row["thesis_action_shares"]),
@@ -212,12 +213,15 @@ def reproduce(
         log(f"nothing to resume in {run_dir}: starting a fresh run")
 
     start = "" if checkpoint is None else f", resuming at step {checkpoint.step}"
-    log(f"[1/3] training {experiment.name} ({experiment.description}): {steps} steps, "
-        f"seed {seed}{start} -> {run_dir}")
+    log(
+        f"[1/3] training {experiment.name} ({experiment.description}): {steps} steps, "
+        f"seed {seed}{start} -> {run_dir}"
+    )
     log(f"      then the thesis evaluation: {episodes} deterministic episodes, static map")
     trained = train(experiment, run_dir, resume=checkpoint, progress_bar=progress)
-    result = ReproduceResult(out=out, run_dir=run_dir, interrupted=trained.interrupted,
-                             train=trained)
+    result = ReproduceResult(
+        out=out, run_dir=run_dir, interrupted=trained.interrupted, train=trained
+    )
     if trained.interrupted or trained.evaluation is None:
         return result
 
@@ -231,9 +235,15 @@ def reproduce(
     dqn = comparison_row(evaluation["model"], "dqn", thesis_dqn, name=f"DQN {experiment.name}")
     rows = [dqn]
     for row in baseline_rows:
-        thesis = None if row.get("thesis_mean") is None else {
-            "mean": row["thesis_mean"], "std": row["thesis_std"], "episodes": 30,
-        }
+        thesis = (
+            None
+            if row.get("thesis_mean") is None
+            else {
+                "mean": row["thesis_mean"],
+                "std": row["thesis_std"],
+                "episodes": 30,
+            }
+        )
         rows.append(comparison_row(row, "heuristic", thesis))
     wall = training_wall_time(run_dir) or trained.wall_time_s
     table = {
@@ -261,8 +271,14 @@ def reproduce(
             "run_dir": str(run_dir),
             "source": experiment.source,
         },
-        "summary": summary_row(evaluation, config=experiment.name, seed=seed,
-                               steps=trained.num_timesteps, wall_time_s=wall, run_dir=run_dir),
+        "summary": summary_row(
+            evaluation,
+            config=experiment.name,
+            seed=seed,
+            steps=trained.num_timesteps,
+            wall_time_s=wall,
+            run_dir=run_dir,
+        ),
         "rows": rows,
         "checks": genuine_checks(dqn),
     }
@@ -293,20 +309,32 @@ def _figures(
 
     dqn = table["rows"][0]
     setting = table["setting"]
-    where = (f"{setting['preset']}, {setting['map_mode']} map, {setting['episodes']} "
-             f"episodes; DQN {table['training']['steps']} steps")
-    model_row = {**evaluation["model"], "policy": dqn["policy"],
-                 "thesis_mean": dqn["thesis_mean"], "thesis_std": dqn["thesis_std"]}
-    files = {"rewards_figure": out / "comparison_rewards.png",
-             "actions_figure": out / "comparison_actions.png",
-             "learning_curve": out / "learning_curve.png"}
-    plot_baselines([model_row, *baseline_rows], files["rewards_figure"],
-                   title=f"ours beside the thesis ({where})")
+    where = (
+        f"{setting['preset']}, {setting['map_mode']} map, {setting['episodes']} "
+        f"episodes; DQN {table['training']['steps']} steps"
+    )
+    model_row = {
+        **evaluation["model"],
+        "policy": dqn["policy"],
+        "thesis_mean": dqn["thesis_mean"],
+        "thesis_std": dqn["thesis_std"],
+    }
+    files = {
+        "rewards_figure": out / "comparison_rewards.png",
+        "actions_figure": out / "comparison_actions.png",
+        "learning_curve": out / "learning_curve.png",
+    }
+    plot_baselines(
+        [model_row, *baseline_rows],
+        files["rewards_figure"],
+        title=f"ours beside the thesis ({where})",
+    )
     plot_action_comparison(
-        dqn["action_shares"], dqn["thesis_action_shares"] or [], files["actions_figure"],
+        dqn["action_shares"],
+        dqn["thesis_action_shares"] or [],
+        files["actions_figure"],
         labels=(f"ours ({table['training']['steps']} steps)", "thesis (1e6 steps)"),
-        title=f"{dqn['policy']}: share of each slot ({setting['episodes']} deterministic "
-        "episodes)",
+        title=f"{dqn['policy']}: share of each slot ({setting['episodes']} deterministic episodes)",
     )
     reference = {}
     if dqn["thesis_mean"] is not None:
@@ -315,7 +343,8 @@ def _figures(
     if greedy is not None:
         reference[f"greedy-distance, ours ({greedy['mean_reward']:.2f})"] = greedy["mean_reward"]
     plot_learning_curve(
-        read_metrics(trained.run_dir / "metrics.jsonl"), files["learning_curve"],
+        read_metrics(trained.run_dir / "metrics.jsonl"),
+        files["learning_curve"],
         title=f"{name} (seed {table['training']['seed']}, {trained.num_timesteps} steps)",
         reference=reference,
     )

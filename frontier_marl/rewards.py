@@ -84,7 +84,9 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
     team = int(events.new_cells.sum())
     values = []
     for new, pad, osc in zip(
-        events.new_cells.tolist(), events.padding.tolist(), events.oscillation.tolist(),
+        events.new_cells.tolist(),
+        events.padding.tolist(),
+        events.oscillation.tolist(),
         strict=True,
     ):
         credited = (1.0 - weight) * new + weight * team if weight else new

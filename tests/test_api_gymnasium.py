@@ -70,7 +70,10 @@ def test_make_by_id(preset: str) -> None:
 
 def test_make_passes_overrides() -> None:
     env = gymnasium.make(
-        frontier_marl.GYM_ID, preset="thesis-30x30", n_slots=6, centroid="relative",
+        frontier_marl.GYM_ID,
+        preset="thesis-30x30",
+        n_slots=6,
+        centroid="relative",
         agent_position=False,
     )
     base = env.unwrapped

@@ -26,8 +26,18 @@ def test_missing_ray_exits_2_with_install_hint(
 ) -> None:
     monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` now raises ImportError
     monkeypatch.setitem(sys.modules, "ray.tune", None)
-    code = main(["campaign", "--configs", "config01", "--steps", "1000",
-                 "--out", str(tmp_path / "c"), "--no-progress"])
+    code = main(
+        [
+            "campaign",
+            "--configs",
+            "config01",
+            "--steps",
+            "1000",
+            "--out",
+            str(tmp_path / "c"),
+            "--no-progress",
+        ]
+    )
     assert code == 2
     assert 'pip install "frontier-marl[ray]"' in capsys.readouterr().err
     assert not (tmp_path / "c").exists()
@@ -45,8 +55,14 @@ def test_require_ray_raises_an_import_error(monkeypatch: pytest.MonkeyPatch) -> 
 def test_build_grid_lists_configs_seeds_budgets(tmp_path: Path) -> None:
     from frontier_marl.campaign import build_grid
 
-    trials = build_grid(CONFIGS, [0, 1], [1000, 500], tmp_path, eval_episodes=2,
-                        overrides=["train.checkpoint_every=0"])
+    trials = build_grid(
+        CONFIGS,
+        [0, 1],
+        [1000, 500],
+        tmp_path,
+        eval_episodes=2,
+        overrides=["train.checkpoint_every=0"],
+    )
     assert len(trials) == 8
     assert len({t.run_dir for t in trials}) == 8
     first = trials[0]
@@ -75,8 +91,22 @@ def local_ray():
 def campaign(local_ray, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
     out = tmp_path_factory.mktemp("campaign") / "out"
     # one trial at a time: the test machine has two cores and other work on them
-    args = ["campaign", "--configs", ",".join(CONFIGS), "--seeds", "0", "--steps", "1000",
-            "--episodes", "2", "--out", str(out), "--max-concurrent", "1", "--no-progress"]
+    args = [
+        "campaign",
+        "--configs",
+        ",".join(CONFIGS),
+        "--seeds",
+        "0",
+        "--steps",
+        "1000",
+        "--episodes",
+        "2",
+        "--out",
+        str(out),
+        "--max-concurrent",
+        "1",
+        "--no-progress",
+    ]
     assert main(args) == 0
     return out, args
 
@@ -114,7 +144,8 @@ def test_campaign_table_matches_the_run_folders(campaign: tuple[Path, list[str]]
     table = json.loads((out / "campaign.json").read_text())["rows"]
     on_disk = collect_runs(out / "runs")
     assert [(r["config"], r["seed"], r["steps"]) for r in on_disk] == [
-        (r["config"], r["seed"], r["steps"]) for r in table]
+        (r["config"], r["seed"], r["steps"]) for r in table
+    ]
     for disk, reported in zip(on_disk, table, strict=True):
         assert disk["mean_reward"] == pytest.approx(reported["mean_reward"])
         assert disk["action_shares"] == pytest.approx(reported["action_shares"])
@@ -135,7 +166,8 @@ def test_campaign_refuses_a_run_folder_of_another_experiment(
     from frontier_marl.campaign import build_grid, run_trial
 
     out, _args = campaign
-    changed = build_grid(["config01"], [0], [1000], out, eval_episodes=2,
-                         overrides=["env.reward=reward1"])[0]
+    changed = build_grid(
+        ["config01"], [0], [1000], out, eval_episodes=2, overrides=["env.reward=reward1"]
+    )[0]
     with pytest.raises(ValueError, match="settings differ"):
         run_trial(changed)

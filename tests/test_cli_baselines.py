@@ -10,24 +10,55 @@ from frontier_marl.cli import main
 from frontier_marl.commands.baselines import parse_set_options, parse_value
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-SMALL = ["--set", "height=8", "--set", "width=9", "--set", "perception_range=2",
-         "--set", "explore_threshold=0.8"]
+SMALL = [
+    "--set",
+    "height=8",
+    "--set",
+    "width=9",
+    "--set",
+    "perception_range=2",
+    "--set",
+    "explore_threshold=0.8",
+]
 
 
 def test_baselines_end_to_end_writes_json_and_png(tmp_path, capsys):
     out_json, out_png = tmp_path / "rows.json", tmp_path / "sub" / "plot.png"
-    code = main([
-        "baselines", "--episodes", "2", "--seed", "3", "--no-progress",
-        "--json", str(out_json), "--plot", str(out_png), *SMALL,
-    ])
+    code = main(
+        [
+            "baselines",
+            "--episodes",
+            "2",
+            "--seed",
+            "3",
+            "--no-progress",
+            "--json",
+            str(out_json),
+            "--plot",
+            str(out_png),
+            *SMALL,
+        ]
+    )
     assert code == 0
     rows = json.loads(out_json.read_text())
     assert [row["policy"] for row in rows] == [
-        "greedy-distance", "greedy-gain", "cost-utility", "random"
+        "greedy-distance",
+        "greedy-gain",
+        "cost-utility",
+        "random",
     ]
     for row in rows:
-        for key in ("mean_reward", "std_reward", "terminations", "episodes", "action_shares",
-                    "mean_steps", "mean_travelled", "cells_to_coverage", "config"):
+        for key in (
+            "mean_reward",
+            "std_reward",
+            "terminations",
+            "episodes",
+            "action_shares",
+            "mean_steps",
+            "mean_travelled",
+            "cells_to_coverage",
+            "config",
+        ):
             assert key in row
         assert row["episodes"] == 2 and row["seeds"] == [3, 4]
         assert len(row["action_shares"]) == 4
@@ -42,8 +73,18 @@ def test_baselines_end_to_end_writes_json_and_png(tmp_path, capsys):
 
 def test_thesis_figures_appear_beside_ours(capsys):
     # the default preset, static map: the thesis's figures are printed for two policies
-    code = main(["baselines", "--episodes", "1", "--no-progress",
-                 "--policies", "greedy-distance,greedy-gain", "--set", "max_steps=5"])
+    code = main(
+        [
+            "baselines",
+            "--episodes",
+            "1",
+            "--no-progress",
+            "--policies",
+            "greedy-distance,greedy-gain",
+            "--set",
+            "max_steps=5",
+        ]
+    )
     assert code == 0
     printed = capsys.readouterr().out
     assert "16.48 ± 1.78" in printed and "15.01 ± 1.12" in printed
@@ -51,8 +92,23 @@ def test_thesis_figures_appear_beside_ours(capsys):
 
 def test_team_and_dynamic_options(tmp_path):
     out_json = tmp_path / "team.json"
-    code = main(["baselines", "--episodes", "1", "--agents", "2", "--map-mode", "dynamic",
-                 "--policies", "greedy-gain", "--no-progress", "--json", str(out_json), *SMALL])
+    code = main(
+        [
+            "baselines",
+            "--episodes",
+            "1",
+            "--agents",
+            "2",
+            "--map-mode",
+            "dynamic",
+            "--policies",
+            "greedy-gain",
+            "--no-progress",
+            "--json",
+            str(out_json),
+            *SMALL,
+        ]
+    )
     assert code == 0
     (row,) = json.loads(out_json.read_text())
     assert row["n_agents"] == 2 and row["map_mode"] == "dynamic" and row["map_seed"] is None
@@ -82,6 +138,11 @@ def test_argparse_errors_exit_2(argv):
 
 def test_set_value_parsing():
     assert parse_set_options(["a=3", "b=0.5", "c=true", "d=full", "e=None", "f-g=False"]) == {
-        "a": 3, "b": 0.5, "c": True, "d": "full", "e": None, "f_g": False,
+        "a": 3,
+        "b": 0.5,
+        "c": True,
+        "d": "full",
+        "e": None,
+        "f_g": False,
     }
     assert isinstance(parse_value("3"), int) and isinstance(parse_value("3.0"), float)

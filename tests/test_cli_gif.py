@@ -16,8 +16,22 @@ SMALL_ARGS = [arg for key, value in SMALL.items() for arg in ("--set", f"{key}={
 
 def test_gif_command_writes_an_animation(tmp_path, capsys):
     out = tmp_path / "episode.gif"
-    code = main(["gif", "--policy", "greedy-gain", "--seed", "1", "--out", str(out),
-                 "--cell-px", "4", "--fps", "8", *SMALL_ARGS])
+    code = main(
+        [
+            "gif",
+            "--policy",
+            "greedy-gain",
+            "--seed",
+            "1",
+            "--out",
+            str(out),
+            "--cell-px",
+            "4",
+            "--fps",
+            "8",
+            *SMALL_ARGS,
+        ]
+    )
     assert code == 0
     assert out.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
     frames = iio.imread(out, index=None)

@@ -47,8 +47,7 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 def test_train_command_writes_run_folder(trained: tuple[Path, Path], capsys) -> None:
     _config, run_dir = trained
-    for name in ("model.zip", "model.json", "evaluation.json", "actions.png",
-                 "learning_curve.png"):
+    for name in ("model.zip", "model.json", "evaluation.json", "actions.png", "learning_curve.png"):
         assert (run_dir / name).is_file(), name
     assert list((run_dir / "tb").glob("events.out.tfevents.*"))
     meta = json.loads((run_dir / "model.json").read_text())
@@ -56,15 +55,24 @@ def test_train_command_writes_run_folder(trained: tuple[Path, Path], capsys) -> 
     assert meta["num_timesteps"] == 800
 
 
-def test_train_resume_extends_the_run(trained: tuple[Path, Path], tmp_path: Path,
-                                      capsys) -> None:
+def test_train_resume_extends_the_run(trained: tuple[Path, Path], tmp_path: Path, capsys) -> None:
     import shutil
 
     _config, run_dir = trained
     copy = tmp_path / "run"
     shutil.copytree(run_dir, copy)
-    code = main(["train", "--resume", str(copy), "--steps", "1000", "--no-progress",
-                 "--set", "train.eval_episodes=1"])
+    code = main(
+        [
+            "train",
+            "--resume",
+            str(copy),
+            "--steps",
+            "1000",
+            "--no-progress",
+            "--set",
+            "train.eval_episodes=1",
+        ]
+    )
     assert code == 0
     out = capsys.readouterr().out
     assert "resuming at step 800" in out
@@ -73,8 +81,9 @@ def test_train_resume_extends_the_run(trained: tuple[Path, Path], tmp_path: Path
     assert json.loads((copy / "evaluation.json").read_text())["model"]["episodes"] == 1
 
 
-def test_train_refuses_bad_input_cleanly(trained: tuple[Path, Path], tmp_path: Path,
-                                         capsys) -> None:
+def test_train_refuses_bad_input_cleanly(
+    trained: tuple[Path, Path], tmp_path: Path, capsys
+) -> None:
     config, run_dir = trained
     assert main(["train", str(config), "--set", "env.centroid=polar", "--no-progress"]) == 2
     assert "centroid" in capsys.readouterr().err
@@ -87,14 +96,29 @@ def test_train_refuses_bad_input_cleanly(trained: tuple[Path, Path], tmp_path: P
     assert main(["train"]) == 2
 
 
-def test_evaluate_command_reports_and_writes_json(trained: tuple[Path, Path], tmp_path: Path,
-                                                  capsys) -> None:
+def test_evaluate_command_reports_and_writes_json(
+    trained: tuple[Path, Path], tmp_path: Path, capsys
+) -> None:
     _config, run_dir = trained
     out_json = tmp_path / "eval.json"
     plot = tmp_path / "actions.png"
-    code = main(["evaluate", str(run_dir / "model.zip"), "--episodes", "3", "--seed", "5",
-                 "--map-mode", "dynamic", "--json", str(out_json), "--plot", str(plot),
-                 "--no-progress"])
+    code = main(
+        [
+            "evaluate",
+            str(run_dir / "model.zip"),
+            "--episodes",
+            "3",
+            "--seed",
+            "5",
+            "--map-mode",
+            "dynamic",
+            "--json",
+            str(out_json),
+            "--plot",
+            str(plot),
+            "--no-progress",
+        ]
+    )
     assert code == 0
     out = capsys.readouterr().out
     assert "greedy-distance" in out and "degenerate" in out
@@ -104,21 +128,24 @@ def test_evaluate_command_reports_and_writes_json(trained: tuple[Path, Path], tm
     model, greedy = result["rows"]
     assert model["seeds"] == greedy["seeds"] == [5, 6, 7]
     for row in (model, greedy):
-        assert {"mean_reward", "std_reward", "terminations", "action_shares",
-                "degeneracy"} <= set(row)
+        assert {"mean_reward", "std_reward", "terminations", "action_shares", "degeneracy"} <= set(
+            row
+        )
         assert sum(row["action_shares"]) == pytest.approx(1.0)
     assert plot.is_file() and plot.stat().st_size > 0
 
 
 def test_evaluate_refuses_a_mismatched_env(trained: tuple[Path, Path], capsys) -> None:
     _config, run_dir = trained
-    code = main(["evaluate", str(run_dir), "--episodes", "1", "--no-progress",
-                 "--set", "centroid=relative"])
+    code = main(
+        ["evaluate", str(run_dir), "--episodes", "1", "--no-progress", "--set", "centroid=relative"]
+    )
     assert code == 2
     err = capsys.readouterr().err
     assert "does not match" in err and "centroid" in err and "Traceback" not in err
-    code = main(["evaluate", str(run_dir), "--episodes", "1", "--no-progress",
-                 "--preset", "thesis-30x30"])
+    code = main(
+        ["evaluate", str(run_dir), "--episodes", "1", "--no-progress", "--preset", "thesis-30x30"]
+    )
     assert code == 2
     assert "height" in capsys.readouterr().err
 
@@ -133,8 +160,19 @@ def test_evaluate_a_team_with_the_shared_parameter_model(
 ) -> None:
     _config, run_dir = trained
     out_json = tmp_path / "team.json"
-    code = main(["evaluate", str(run_dir), "--agents", "3", "--episodes", "2",
-                 "--json", str(out_json), "--no-progress"])
+    code = main(
+        [
+            "evaluate",
+            str(run_dir),
+            "--agents",
+            "3",
+            "--episodes",
+            "2",
+            "--json",
+            str(out_json),
+            "--no-progress",
+        ]
+    )
     assert code == 0
     result = json.loads(out_json.read_text())
     assert result["env_config"]["n_agents"] == 3
@@ -147,8 +185,19 @@ def test_evaluate_a_team_with_the_shared_parameter_model(
 
 def test_evaluate_the_shipped_model_by_name(tmp_path: Path, capsys) -> None:
     out_json = tmp_path / "shipped.json"
-    code = main(["evaluate", "thesis-config01", "--episodes", "2", "--heuristics", "",
-                 "--json", str(out_json), "--no-progress"])
+    code = main(
+        [
+            "evaluate",
+            "thesis-config01",
+            "--episodes",
+            "2",
+            "--heuristics",
+            "",
+            "--json",
+            str(out_json),
+            "--no-progress",
+        ]
+    )
     assert code == 0
     result = json.loads(out_json.read_text())
     assert result["num_timesteps"] == 1_000_000

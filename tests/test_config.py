@@ -37,10 +37,7 @@ BAD_VALUES = [
     ("map_mode", "moving", "map_mode"),
     ("map_seed", -1, "map_seed"),
     ("map_seed", 0.5, "map_seed"),
-    *[
-        pytest.param("map_path", value, "map_path")
-        for value in ("/nonexistent/map.txt", 5)
-    ],
+    *[pytest.param("map_path", value, "map_path") for value in ("/nonexistent/map.txt", 5)],
     ("perception_range", 0, "perception_range"),
     ("perception_range", 21, "perception_range"),  # larger than the 20x20 map
     ("sensor", "lidar", "sensor"),

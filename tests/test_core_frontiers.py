@@ -373,8 +373,9 @@ def test_cluster_properties_on_random_beliefs(belief, connectivity, max_cells):
     labels = clusters.labels()
     np.testing.assert_array_equal(labels > 0, mask)
     np.testing.assert_array_equal(labels[mask] - 1, clusters.cell_cluster)
-    np.testing.assert_array_equal(np.bincount(clusters.cell_cluster, minlength=clusters.count),
-                                  clusters.sizes)
+    np.testing.assert_array_equal(
+        np.bincount(clusters.cell_cluster, minlength=clusters.count), clusters.sizes
+    )
     assert (clusters.sizes >= 1).all()
     if max_cells > 0:
         assert (clusters.sizes <= max_cells).all()

@@ -200,7 +200,11 @@ def test_raycast_four_neighbours_always_seen_behind_diagonal_walls():
     )
     rows, cols = RaycastSensor(1).visible_cells(true_grid, (1, 1))
     assert {(int(r), int(c)) for r, c in zip(rows, cols, strict=True)} == {
-        (0, 1), (1, 0), (1, 1), (1, 2), (2, 1)
+        (0, 1),
+        (1, 0),
+        (1, 1),
+        (1, 2),
+        (2, 1),
     }
 
 

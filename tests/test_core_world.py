@@ -325,8 +325,17 @@ def _check_state(world: World, previous_known: np.ndarray) -> np.ndarray:
     seed=st.integers(0, 2**32 - 1),
 )
 def test_world_invariants_under_random_play(
-    height, width, obstacle_prob, n_agents, sensor, radius, cells_per_step, connectivity,
-    max_cluster_cells, gain, seed,
+    height,
+    width,
+    obstacle_prob,
+    n_agents,
+    sensor,
+    radius,
+    cells_per_step,
+    connectivity,
+    max_cluster_cells,
+    gain,
+    seed,
 ):
     rng = np.random.default_rng(seed)
     true_grid = random_obstacle_map(height, width, obstacle_prob, rng)
@@ -370,9 +379,7 @@ def test_world_invariants_under_random_play(
                 assert len(path) - 1 <= cells_per_step
             if targets[agent] is None:
                 assert len(path) == 1
-            assert result.reached[agent] == (
-                len(path) > 1 and tuple(path[-1]) == targets[agent]
-            )
+            assert result.reached[agent] == (len(path) > 1 and tuple(path[-1]) == targets[agent])
         np.testing.assert_array_equal(
             world.travelled - travelled, [len(p) - 1 for p in result.paths]
         )

@@ -85,9 +85,17 @@ CROSS_PROCESS_CASES: list[tuple[str, dict[str, Any], int]] = [
     ("parallel", {"preset": "thesis-20x20", "n_agents": 3, "map_mode": "dynamic"}, 3),
     (
         "parallel",
-        {"preset": "thesis-30x30", "n_agents": 2, "sensor": "raycast", "gain": "unknown",
-         "info_gain": True, "centroid": "relative", "sort_by_distance": True,
-         "cells_per_step": "full", "action_mask": True},
+        {
+            "preset": "thesis-30x30",
+            "n_agents": 2,
+            "sensor": "raycast",
+            "gain": "unknown",
+            "info_gain": True,
+            "centroid": "relative",
+            "sort_by_distance": True,
+            "cells_per_step": "full",
+            "action_mask": True,
+        },
         5,
     ),
 ]
@@ -108,9 +116,7 @@ def _record_parallel(env: Any, seed: int, steps: int, policy_seed: int = 0) -> l
     for _ in range(steps):
         if not env.agents:
             break
-        actions = {
-            a: int(rng.choice(np.flatnonzero(infos[a]["action_mask"]))) for a in env.agents
-        }
+        actions = {a: int(rng.choice(np.flatnonzero(infos[a]["action_mask"]))) for a in env.agents}
         obs, rewards, terms, truncs, infos = env.step(actions)
         record.append(_copy((actions, obs, rewards, terms, truncs, infos)))
     record.append(_copy((env.world.belief, env.world.positions, env.world.travelled)))
@@ -171,8 +177,13 @@ PARALLEL_CONFIGS = [
     pytest.param({"n_agents": 1}, id="static-n1"),
     pytest.param({"n_agents": 3, "map_mode": "dynamic"}, id="dynamic-n3"),
     pytest.param(
-        {"preset": "thesis-30x30", "n_agents": 2, "cells_per_step": "full", "sensor": "raycast",
-         "action_mask": True},
+        {
+            "preset": "thesis-30x30",
+            "n_agents": 2,
+            "cells_per_step": "full",
+            "sensor": "raycast",
+            "action_mask": True,
+        },
         id="30x30-full-raycast-n2",
     ),
 ]
@@ -222,8 +233,12 @@ def test_gym_and_parallel_agree_with_one_robot() -> None:
             _assert_same(
                 (action, obs, reward, terminated, truncated, info),
                 (
-                    p_actions["robot_0"], p_obs["robot_0"], p_rewards["robot_0"],
-                    p_terms["robot_0"], p_truncs["robot_0"], p_infos["robot_0"],
+                    p_actions["robot_0"],
+                    p_obs["robot_0"],
+                    p_rewards["robot_0"],
+                    p_terms["robot_0"],
+                    p_truncs["robot_0"],
+                    p_infos["robot_0"],
                 ),
             )
         _assert_same(gym_record[-1], par_record[-1])
@@ -250,7 +265,11 @@ def test_determinism_across_processes() -> None:
         env = dict(os.environ, PYTHONHASHSEED=hash_seed)
         done = subprocess.run(
             [sys.executable, "-c", code, json.dumps(CROSS_PROCESS_CASES)],
-            capture_output=True, text=True, env=env, timeout=120, check=False,
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=120,
+            check=False,
         )
         assert done.returncode == 0, done.stderr
         outputs.append(json.loads(done.stdout.strip().splitlines()[-1]))

@@ -14,8 +14,19 @@ from frontier_marl import FrontierExploreEnv
 from frontier_marl.core.grid import FREE, UNKNOWN
 
 INFO_KEYS = {
-    "explored_fraction", "coverage", "new_cells", "action_mask", "clusters", "path", "target",
-    "position", "travelled", "padding", "oscillation", "step", "end_reason",
+    "explored_fraction",
+    "coverage",
+    "new_cells",
+    "action_mask",
+    "clusters",
+    "path",
+    "target",
+    "position",
+    "travelled",
+    "padding",
+    "oscillation",
+    "step",
+    "end_reason",
 }
 CLUSTER_KEYS = {"slot", "cluster", "centroid", "target", "size", "gain", "distance"}
 FOUR = ndimage.generate_binary_structure(2, 1)
@@ -188,8 +199,11 @@ OBS_CASES = [
         id=f"{c}-gain{int(g)}-pos{int(p)}-mask{int(m)}-norm{int(n)}",
     )
     for c, g, p, m, n in itertools.product(
-        ["absolute", "relative", "distance", "none"], [False, True], [False, True],
-        [False, True], [False, True],
+        ["absolute", "relative", "distance", "none"],
+        [False, True],
+        [False, True],
+        [False, True],
+        [False, True],
     )
     if c != "none" or g
 ]
@@ -280,8 +294,13 @@ def _check_infos(env: Any, infos: dict[str, Any]) -> None:
         pytest.param({"n_agents": 1}, id="n1"),
         pytest.param({"n_agents": 3, "map_mode": "dynamic", "sort_by_distance": True}, id="n3"),
         pytest.param(
-            {"preset": "thesis-30x30", "n_agents": 2, "n_slots": 6, "cells_per_step": "full",
-             "sensor": "raycast"},
+            {
+                "preset": "thesis-30x30",
+                "n_agents": 2,
+                "n_slots": 6,
+                "cells_per_step": "full",
+                "sensor": "raycast",
+            },
             id="30x30-full",
         ),
         pytest.param({"height": 11, "width": 23, "connectivity": 4}, id="non-square"),
@@ -343,11 +362,19 @@ ENCODINGS = ["absolute", "relative", "distance"]
 def test_cluster_features_encode_the_slot_table(centroid: str, normalize: bool) -> None:
     height, width = 13, 21
     env = frontier_marl.parallel_env(
-        height=height, width=width, n_agents=2, centroid=centroid, info_gain=True,
-        agent_position=True, normalize=normalize, n_slots=5, map_mode="dynamic",
+        height=height,
+        width=width,
+        n_agents=2,
+        centroid=centroid,
+        info_gain=True,
+        agent_position=True,
+        normalize=normalize,
+        n_slots=5,
+        map_mode="dynamic",
     )
     scale = {
-        "absolute": [height, width], "relative": [height, width],
+        "absolute": [height, width],
+        "relative": [height, width],
         "distance": [float(np.hypot(height, width))],
     }[centroid]
     gain_scale = float(env.config.max_cluster_cells)
@@ -372,10 +399,9 @@ def test_cluster_features_encode_the_slot_table(centroid: str, normalize: bool) 
                 if normalize:
                     feature = feature / np.array(scale)
                 gain = entry["gain"] / (gain_scale if normalize else 1.0)
-                np.testing.assert_allclose(table[entry["slot"], :-1], feature, rtol=1e-5,
-                                           atol=1e-5)
+                np.testing.assert_allclose(table[entry["slot"], :-1], feature, rtol=1e-5, atol=1e-5)
                 np.testing.assert_allclose(table[entry["slot"], -1], gain, rtol=1e-5)
-            padding_rows = table[len(live):]
+            padding_rows = table[len(live) :]
             padding_seen |= len(padding_rows) > 0
             assert not padding_rows.any(), "padding slots must be all zeros"
         if not env.agents:
@@ -395,7 +421,7 @@ def test_relative_encoding_flat_box() -> None:
             np.testing.assert_allclose(
                 table[entry["slot"]], np.array(entry["centroid"]) - position, atol=1e-5
             )
-        assert not table[len(info["clusters"]):].any()
+        assert not table[len(info["clusters"]) :].any()
         obs, _, terminated, truncated, info = env.step(
             int(rng.choice(np.flatnonzero(info["action_mask"])))
         )
@@ -421,15 +447,18 @@ def _explore_fully(env: Any, seed: int) -> tuple[Any, Any, Any, Any, Any]:
     for _ in range(2000):
         if not env.agents:
             return out
-        out = env.step(
-            {a: int(np.flatnonzero(out[4][a]["action_mask"])[0]) for a in env.agents}
-        )
+        out = env.step({a: int(np.flatnonzero(out[4][a]["action_mask"])[0]) for a in env.agents})
     raise AssertionError("episode did not end")
 
 
 FULL = {
-    "explore_threshold": 1.0, "threshold_basis": "reachable", "cells_per_step": "full",
-    "max_steps": 2000, "no_progress_limit": 2000, "height": 10, "width": 10,
+    "explore_threshold": 1.0,
+    "threshold_basis": "reachable",
+    "cells_per_step": "full",
+    "max_steps": 2000,
+    "no_progress_limit": 2000,
+    "height": 10,
+    "width": 10,
 }
 
 
@@ -561,8 +590,12 @@ def test_episode_ends_for_all_agents_together(kwargs: dict[str, Any]) -> None:
 @pytest.mark.parametrize("cells_per_step", [1, 3, "full"])
 def test_robots_never_share_a_cell(cells_per_step: int | str) -> None:
     env = frontier_marl.parallel_env(
-        n_agents=5, cells_per_step=cells_per_step, map_mode="dynamic", obstacle_prob=0.3,
-        height=14, width=14,
+        n_agents=5,
+        cells_per_step=cells_per_step,
+        map_mode="dynamic",
+        obstacle_prob=0.3,
+        height=14,
+        width=14,
     )
     rng = np.random.default_rng(7)
     steps = 0

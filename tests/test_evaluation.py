@@ -23,8 +23,13 @@ from frontier_marl.policies import CallablePolicy, make_policy
 
 # A tiny map. explore_threshold < 1 keeps episodes from running out of frontiers, which
 # currently crashes the env (see test_fully_known_map_gives_exact_numbers).
-TINY = {"height": 5, "width": 6, "obstacle_prob": 0.1, "perception_range": 1,
-        "explore_threshold": 0.8}
+TINY = {
+    "height": 5,
+    "width": 6,
+    "obstacle_prob": 0.1,
+    "perception_range": 1,
+    "explore_threshold": 0.8,
+}
 
 
 def nearest(info: dict) -> int:
@@ -99,8 +104,13 @@ def test_evaluate_matches_stepping_the_env_by_hand(kwargs):
 
 
 def test_team_reward_is_the_mean_of_robot_returns():
-    kwargs = {"height": 10, "width": 10, "obstacle_prob": 0.15, "n_agents": 2,
-              "explore_threshold": 0.9}
+    kwargs = {
+        "height": 10,
+        "width": 10,
+        "obstacle_prob": 0.15,
+        "n_agents": 2,
+        "explore_threshold": 0.9,
+    }
     result = evaluate(kwargs, make_policy("greedy-distance"), episodes=2, seed=0)
     for i, episode in enumerate(result.episodes):
         manual = manual_episode(kwargs, i)
@@ -137,8 +147,10 @@ def test_gymnasium_env_and_parallel_env_agree():
     kwargs = {**TINY, "map_mode": "dynamic"}
     par = evaluate(kwargs, make_policy("cost-utility"), episodes=3, seed=2)
     single = evaluate(
-        lambda: gym.make(frontier_marl.GYM_ID, **kwargs), make_policy("cost-utility"),
-        episodes=3, seed=2,
+        lambda: gym.make(frontier_marl.GYM_ID, **kwargs),
+        make_policy("cost-utility"),
+        episodes=3,
+        seed=2,
     )
     assert single.to_dict() == par.to_dict()
 
@@ -172,9 +184,13 @@ def test_max_steps_caps_episodes():
 
 @pytest.mark.parametrize(
     "kwargs, match",
-    [({"episodes": 0}, "episodes"), ({"seed": -1}, "seed"),
-     ({"coverage_levels": (0.0,)}, "coverage_levels"), ({"max_steps": 0}, "max_steps"),
-     ({"map_mode": "fixed"}, "map_mode")],
+    [
+        ({"episodes": 0}, "episodes"),
+        ({"seed": -1}, "seed"),
+        ({"coverage_levels": (0.0,)}, "coverage_levels"),
+        ({"max_steps": 0}, "max_steps"),
+        ({"map_mode": "fixed"}, "map_mode"),
+    ],
 )
 def test_invalid_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -197,7 +213,12 @@ def test_cells_to_coverage_and_resampling():
     assert cells_to_coverage(curve, 0.95) == 9
     assert cells_to_coverage(curve[:2], 0.9) is None
     assert resample_curve(curve, np.array([0, 1, 2, 4, 5, 20])).tolist() == [
-        0.1, 0.1, 0.5, 0.5, 0.9, 1.0
+        0.1,
+        0.1,
+        0.5,
+        0.5,
+        0.9,
+        1.0,
     ]
     with pytest.raises(ValueError, match="level"):
         cells_to_coverage(curve, 1.5)

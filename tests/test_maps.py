@@ -177,8 +177,17 @@ def test_pgm_p5_p2_and_16_bit_parse_to_the_same_grid():
         (b"P2\n2 2\n255\n255 0\n", "2 pixels, expected 2x2"),
         (b"P5\n2 2\n255\n" + bytes(4), "no free cell"),
     ],
-    ids=["magic", "truncated", "empty", "non-integer", "zero-size", "maxval", "short",
-         "short-ascii", "no-free-cell"],
+    ids=[
+        "magic",
+        "truncated",
+        "empty",
+        "non-integer",
+        "zero-size",
+        "maxval",
+        "short",
+        "short-ascii",
+        "no-free-cell",
+    ],
 )
 def test_pgm_loader_rejects_malformed_files(tmp_path, data, match):
     path = tmp_path / "bad.pgm"
@@ -303,8 +312,11 @@ def test_example_maps_script_check_passes():
 
 @pytest.mark.parametrize(
     ("kwargs", "name"),
-    [({"corridor_width": 0}, "corridor_width"), ({"min_room": 5, "max_room": 3}, "max_room"),
-     ({"min_room": 0}, "min_room")],
+    [
+        ({"corridor_width": 0}, "corridor_width"),
+        ({"min_room": 5, "max_room": 3}, "max_room"),
+        ({"min_room": 0}, "min_room"),
+    ],
 )
 def test_rooms_map_rejects_bad_parameters(kwargs, name):
     with pytest.raises(ValueError, match=name):

@@ -81,8 +81,10 @@ def test_team_weight_on_a_hand_made_two_robot_step(corridor, weight, expected):
     # column after it, with none. Cell term: 0.05 * ((1 - w) * own + w * team), team = 3;
     # robot 1 also pays the no-new-cell penalty (-0.05), whatever w.
     env, _, infos = corridor_env(corridor, team_weight=weight)
-    actions = {"robot_0": slot_of(infos["robot_0"], (1, 5)),
-               "robot_1": slot_of(infos["robot_1"], (1, 7))}
+    actions = {
+        "robot_0": slot_of(infos["robot_0"], (1, 5)),
+        "robot_1": slot_of(infos["robot_1"], (1, 7)),
+    }
     _, rewards, terminations, truncations, infos = env.step(actions)
     assert [infos[a]["new_cells"] for a in ("robot_0", "robot_1")] == [3, 0]
     assert env.world.positions.tolist() == [[1, 5], [1, 7]]
@@ -92,18 +94,24 @@ def test_team_weight_on_a_hand_made_two_robot_step(corridor, weight, expected):
 
 def test_team_weight_step_outcome_exact_values():
     events = StepEvents(
-        new_cells=np.array([4, 0, 2]), padding=np.array([False, True, False]),
-        oscillation=np.array([False, False, True]), threshold_reached=False,
-        no_frontier_left=False, steps_taken=1, steps_without_progress=0,
+        new_cells=np.array([4, 0, 2]),
+        padding=np.array([False, True, False]),
+        oscillation=np.array([False, False, True]),
+        threshold_reached=False,
+        no_frontier_left=False,
+        steps_taken=1,
+        steps_without_progress=0,
     )
     cfg = make_config(team_weight=0.25).reward  # Reward 2: padding -0.1, oscillation -0.05
     rewards = step_outcome(cfg, events).rewards
     team = 6
-    assert rewards == pytest.approx([
-        0.05 * (0.75 * 4 + 0.25 * team),
-        0.05 * (0.25 * team) - 0.05 - 0.1,
-        0.05 * (0.75 * 2 + 0.25 * team) - 0.05,
-    ])
+    assert rewards == pytest.approx(
+        [
+            0.05 * (0.75 * 4 + 0.25 * team),
+            0.05 * (0.25 * team) - 0.05 - 0.1,
+            0.05 * (0.75 * 2 + 0.25 * team) - 0.05,
+        ]
+    )
 
 
 @pytest.mark.parametrize("weight", [0.0, 0.3, 1.0])
@@ -137,13 +145,15 @@ def test_teammates_positions_and_targets(corridor):
     assert obs["robot_0"]["teammates"].tolist() == [1, 8, 0, 0]
     assert obs["robot_1"]["teammates"].tolist() == [1, 4, 0, 0]
     # step 1: both reach their one-cell-away targets, so neither has a target left
-    obs, _, _, _, infos = env.step({"robot_0": slot_of(infos["robot_0"], (1, 5)),
-                                    "robot_1": slot_of(infos["robot_1"], (1, 7))})
+    obs, _, _, _, infos = env.step(
+        {"robot_0": slot_of(infos["robot_0"], (1, 5)), "robot_1": slot_of(infos["robot_1"], (1, 7))}
+    )
     assert obs["robot_0"]["teammates"].tolist() == [1, 7, 0, 0]
     # step 2: robot 0 heads for (1, 3), two cells away, and stops half-way (one cell per
     # step); robot 1 idles on a padding slot, so it has no target
-    obs, _, _, _, infos = env.step({"robot_0": slot_of(infos["robot_0"], (1, 3)),
-                                    "robot_1": padding_slot(infos["robot_1"])})
+    obs, _, _, _, infos = env.step(
+        {"robot_0": slot_of(infos["robot_0"], (1, 3)), "robot_1": padding_slot(infos["robot_1"])}
+    )
     assert env.world.positions.tolist() == [[1, 4], [1, 7]]
     assert obs["robot_1"]["teammates"].tolist() == [1, 4, 1, 3]
     assert obs["robot_0"]["teammates"].tolist() == [1, 7, 0, 0]
@@ -167,8 +177,14 @@ def test_teammates_positions_only_in_agent_order():
 @pytest.mark.parametrize("layout", ["positions", "positions+targets"])
 def test_teammates_observations_stay_in_their_space(layout, normalize):
     env = frontier_marl.parallel_env(
-        map_generator="rooms", height=20, width=28, n_agents=3, teammates=layout,
-        normalize=normalize, action_mask=True, map_mode="dynamic",
+        map_generator="rooms",
+        height=20,
+        width=28,
+        n_agents=3,
+        teammates=layout,
+        normalize=normalize,
+        action_mask=True,
+        map_mode="dynamic",
     )
     policy = make_policy("random", seed=0)
     obs, infos = env.reset(seed=1)
@@ -184,8 +200,9 @@ def test_teammates_observations_stay_in_their_space(layout, normalize):
 # ----------------------------------------------------------------- joint heuristics
 
 
-def free_info(clusters: list[tuple[int, tuple[int, int]]], position: tuple[int, int],
-              belief: np.ndarray) -> dict:
+def free_info(
+    clusters: list[tuple[int, tuple[int, int]]], position: tuple[int, int], belief: np.ndarray
+) -> dict:
     """A robot's info with live slots 0.. holding (cluster index, target) in that order."""
     mask = np.zeros(4, np.int8)
     mask[: len(clusters)] = 1
@@ -193,9 +210,15 @@ def free_info(clusters: list[tuple[int, tuple[int, int]]], position: tuple[int, 
         mask[0] = 1
     return {
         "clusters": [
-            {"slot": s, "cluster": c, "centroid": (float(t[0]), float(t[1])), "target": t,
-             "size": 1, "gain": 1.0,
-             "distance": float(np.hypot(t[0] - position[0], t[1] - position[1]))}
+            {
+                "slot": s,
+                "cluster": c,
+                "centroid": (float(t[0]), float(t[1])),
+                "target": t,
+                "size": 1,
+                "gain": 1.0,
+                "distance": float(np.hypot(t[0] - position[0], t[1] - position[1])),
+            }
             for s, (c, t) in enumerate(clusters)
         ],
         "action_mask": mask,
@@ -215,15 +238,24 @@ def team_states(draw: st.DrawFn) -> tuple[dict[str, dict], dict[int, tuple[int, 
     free_cells = [tuple(c) for c in np.argwhere(belief == FREE).tolist()]
     n_robots = draw(st.integers(1, 5))
     n_clusters = draw(st.integers(0, 6))
-    cells = draw(st.lists(st.sampled_from(free_cells), min_size=n_robots + n_clusters,
-                          max_size=n_robots + n_clusters, unique=True))
+    cells = draw(
+        st.lists(
+            st.sampled_from(free_cells),
+            min_size=n_robots + n_clusters,
+            max_size=n_robots + n_clusters,
+            unique=True,
+        )
+    )
     positions, targets = cells[:n_robots], cells[n_robots:]
     infos = {}
     for i, position in enumerate(positions):
         reach = bfs_distances(belief == FREE, position)
         reachable = [c for c in range(n_clusters) if reach[targets[c]] >= 0]
-        offered = draw(st.lists(st.sampled_from(reachable), max_size=4, unique=True)
-                       if reachable else st.just([]))
+        offered = draw(
+            st.lists(st.sampled_from(reachable), max_size=4, unique=True)
+            if reachable
+            else st.just([])
+        )
         infos[f"robot_{i}"] = free_info([(c, targets[c]) for c in offered], position, belief)
     return infos, dict(enumerate(targets))
 
@@ -391,7 +423,10 @@ def test_utility_discount_formula():
     assert UtilityDiscount(beta=0.0, sensor_range=3).act_team(obs, infos)["robot_1"] == 2
     assert UtilityDiscount(beta=0.0, sensor_range=2).act_team(obs, infos)["robot_1"] == 1
     assert UtilityDiscount.visibility(np.array([0.0, 1.5, 3.0, 7.0]), 3.0).tolist() == [
-        1.0, 0.5, 0.0, 0.0
+        1.0,
+        0.5,
+        0.0,
+        0.0,
     ]
 
 
@@ -419,8 +454,10 @@ def test_team_heuristics_need_a_map_and_a_range():
         with pytest.raises(ValueError, match="belief"):
             make_policy(name).act_team({"a": None, "b": None}, {"a": info, "b": info})
     belief = np.full((1, 5), FREE, np.int8)
-    infos = {"a": free_info([(0, (0, 2))], (0, 0), belief),
-             "b": free_info([(0, (0, 2))], (0, 4), belief)}
+    infos = {
+        "a": free_info([(0, (0, 2))], (0, 0), belief),
+        "b": free_info([(0, (0, 2))], (0, 4), belief),
+    }
     with pytest.raises(ValueError, match="sensor range"):
         UtilityDiscount().act_team(dict.fromkeys(infos), infos)
     with pytest.raises(ValueError, match="world"):
@@ -472,13 +509,20 @@ def manual_team_episode(kwargs: dict, seed: int) -> dict:
     for level in (0.9, 0.99):
         hit = next((i for i, c in enumerate(coverage) if c >= level), None)
         first[level] = None if hit is None else (max(travelled[hit]), sum(travelled[hit]))
-    return {"travelled": travelled, "first": first,
-            "overlap": overlap_ratio(np.asarray(env.world.seen))}
+    return {
+        "travelled": travelled,
+        "first": first,
+        "overlap": overlap_ratio(np.asarray(env.world.seen)),
+    }
 
 
 def test_evaluation_reports_team_metrics():
-    kwargs = {"map_path": str(example_map_path("rooms-32")), "n_agents": 3,
-              "explore_threshold": 1.0, "no_progress_limit": 200}
+    kwargs = {
+        "map_path": str(example_map_path("rooms-32")),
+        "n_agents": 3,
+        "explore_threshold": 1.0,
+        "no_progress_limit": 200,
+    }
     result = evaluate(kwargs, make_policy("greedy-distance"), episodes=2, seed=1)
     for episode, seed in zip(result.episodes, (1, 2), strict=True):
         manual = manual_team_episode(kwargs, seed)
@@ -497,8 +541,13 @@ def test_evaluation_reports_team_metrics():
     assert row["makespan_to_coverage"]["0.99"]["reached"] == 2
     assert row["mean_overlap"] == pytest.approx(np.mean([e.overlap for e in result.episodes]))
     episode = row["per_episode"][0]
-    assert {"makespan", "makespan_to_coverage", "overlap", "robot_travelled",
-            "makespan_curve"} <= set(episode)
+    assert {
+        "makespan",
+        "makespan_to_coverage",
+        "overlap",
+        "robot_travelled",
+        "makespan_curve",
+    } <= set(episode)
     single = evaluate({**kwargs, "n_agents": 1}, make_policy("greedy-distance"), episodes=1)
     assert "mean_makespan" not in single.to_dict()
     assert "makespan" not in single.to_dict()["per_episode"][0]
@@ -506,8 +555,12 @@ def test_evaluation_reports_team_metrics():
 
 def test_coordination_beats_independent_greedy_on_overlap_with_four_robots():
     # A smoke check of the experiment's direction (docs/multi-robot.md has the full numbers).
-    kwargs = {"map_path": str(example_map_path("rooms-32")), "n_agents": 4,
-              "explore_threshold": 1.0, "no_progress_limit": 200}
+    kwargs = {
+        "map_path": str(example_map_path("rooms-32")),
+        "n_agents": 4,
+        "explore_threshold": 1.0,
+        "no_progress_limit": 200,
+    }
     greedy = evaluate(kwargs, make_policy("greedy-distance"), episodes=8, seed=0)
     coordinated = evaluate(kwargs, make_policy("coordinated-assignment"), episodes=8, seed=0)
     assert coordinated.team_summary()["mean_overlap"] < greedy.team_summary()["mean_overlap"]
@@ -516,22 +569,46 @@ def test_coordination_beats_independent_greedy_on_overlap_with_four_robots():
 # ----------------------------------------------------------------- commands
 
 
-SMALL = ["--set", "perception_range=3", "--set", "explore_threshold=1.0",
-         "--set", "no_progress_limit=200"]
+SMALL = [
+    "--set",
+    "perception_range=3",
+    "--set",
+    "explore_threshold=1.0",
+    "--set",
+    "no_progress_limit=200",
+]
 
 
 def test_baselines_team_table_and_json(tmp_path, capsys):
     out_json, out_png = tmp_path / "team.json", tmp_path / "team.png"
-    code = main(["baselines", "--episodes", "2", "--agents", "2", "--map", "rooms-32",
-                 "--policies", "greedy-distance,coordinated-assignment,utility-discount",
-                 "--no-progress", "--json", str(out_json), "--plot", str(out_png), *SMALL])
+    code = main(
+        [
+            "baselines",
+            "--episodes",
+            "2",
+            "--agents",
+            "2",
+            "--map",
+            "rooms-32",
+            "--policies",
+            "greedy-distance,coordinated-assignment,utility-discount",
+            "--no-progress",
+            "--json",
+            str(out_json),
+            "--plot",
+            str(out_png),
+            *SMALL,
+        ]
+    )
     assert code == 0
     printed = capsys.readouterr().out
     assert "makespan→90%" in printed and "makespan→99%" in printed and "overlap" in printed
     assert "file rooms-32.txt" in printed
     rows = json.loads(out_json.read_text())
     assert [r["policy"] for r in rows] == [
-        "greedy-distance", "coordinated-assignment", "utility-discount"
+        "greedy-distance",
+        "coordinated-assignment",
+        "utility-discount",
     ]
     for row in rows:
         assert row["n_agents"] == 2 and row["config"]["height"] == 32
@@ -541,26 +618,77 @@ def test_baselines_team_table_and_json(tmp_path, capsys):
 
 
 def test_baselines_single_robot_table_has_no_team_columns(capsys):
-    assert main(["baselines", "--episodes", "1", "--policies", "greedy-distance",
-                 "--no-progress", "--set", "max_steps=5"]) == 0
+    assert (
+        main(
+            [
+                "baselines",
+                "--episodes",
+                "1",
+                "--policies",
+                "greedy-distance",
+                "--no-progress",
+                "--set",
+                "max_steps=5",
+            ]
+        )
+        == 0
+    )
     assert "makespan" not in capsys.readouterr().out
 
 
 def test_map_generator_and_map_options(tmp_path, capsys):
-    assert main(["baselines", "--episodes", "1", "--agents", "2", "--map-generator", "rooms",
-                 "--policies", "utility-discount", "--no-progress", "--set", "height=16",
-                 "--set", "width=24", "--set", "max_steps=20"]) == 0
+    assert (
+        main(
+            [
+                "baselines",
+                "--episodes",
+                "1",
+                "--agents",
+                "2",
+                "--map-generator",
+                "rooms",
+                "--policies",
+                "utility-discount",
+                "--no-progress",
+                "--set",
+                "height=16",
+                "--set",
+                "width=24",
+                "--set",
+                "max_steps=20",
+            ]
+        )
+        == 0
+    )
     assert "rooms, map_seed=0" in capsys.readouterr().out
     map_file = tmp_path / "plan.txt"
     map_file.write_text(CORRIDOR)
     out = tmp_path / "ep.gif"
-    assert main(["gif", "--policy", "coordinated-assignment", "--agents", "2",
-                 "--map", str(map_file), "--out", str(out), "--max-steps", "3"]) == 0
+    assert (
+        main(
+            [
+                "gif",
+                "--policy",
+                "coordinated-assignment",
+                "--agents",
+                "2",
+                "--map",
+                str(map_file),
+                "--out",
+                str(out),
+                "--max-steps",
+                "3",
+            ]
+        )
+        == 0
+    )
     assert out.read_bytes()[:3] == b"GIF"
-    for bad in (["--map", "rooms-32", "--map-generator", "rooms"],
-                ["--map", str(tmp_path / "missing.txt")],
-                ["--map", "rooms-32", "--set", "map_path=x.txt"],
-                ["--map", "rooms-32", "--map-mode", "dynamic"]):
+    for bad in (
+        ["--map", "rooms-32", "--map-generator", "rooms"],
+        ["--map", str(tmp_path / "missing.txt")],
+        ["--map", "rooms-32", "--set", "map_path=x.txt"],
+        ["--map", "rooms-32", "--map-mode", "dynamic"],
+    ):
         assert main(["baselines", "--episodes", "1", "--no-progress", *bad]) == 2
     err = capsys.readouterr().err
     assert "exclude each other" in err and "does not exist" in err and "map_mode" in err
@@ -568,14 +696,23 @@ def test_map_generator_and_map_options(tmp_path, capsys):
 
 def test_multi_robot_experiment_script_runs(tmp_path):
     module = runpy.run_path(str(REPO / "baselines" / "multi_robot.py"))
-    settings_ = {"tiny": {"map_path": str(example_map_path("rooms-32")),
-                          "explore_threshold": 1.0, "no_progress_limit": 200}}
-    policies = {name: (lambda name=name: make_policy(name))
-                for name in ("greedy-distance", "coordinated-assignment")}
+    settings_ = {
+        "tiny": {
+            "map_path": str(example_map_path("rooms-32")),
+            "explore_threshold": 1.0,
+            "no_progress_limit": 200,
+        }
+    }
+    policies = {
+        name: (lambda name=name: make_policy(name))
+        for name in ("greedy-distance", "coordinated-assignment")
+    }
     rows = module["run_experiment"](settings_, policies, [1, 2], episodes=2, log=lambda _: None)
     assert [(r["n_agents"], r["policy"]) for r in rows] == [
-        (1, "greedy-distance"), (1, "coordinated-assignment"),
-        (2, "greedy-distance"), (2, "coordinated-assignment"),
+        (1, "greedy-distance"),
+        (1, "coordinated-assignment"),
+        (2, "greedy-distance"),
+        (2, "coordinated-assignment"),
     ]
     table = module["results_table"](rows)
     assert table.count("\n") == 5 and "| tiny | 2 | coordinated-assignment |" in table
@@ -594,11 +731,21 @@ def test_multi_robot_experiment_script_runs(tmp_path):
 
 API_CASES = [
     pytest.param({"map_path": "rooms-32"}, id="loaded-rooms-32"),
-    pytest.param({"map_path": "rooms-32", "teammates": "positions+targets",
-                  "action_mask": True}, id="loaded-teammates"),
+    pytest.param(
+        {"map_path": "rooms-32", "teammates": "positions+targets", "action_mask": True},
+        id="loaded-teammates",
+    ),
     pytest.param({"map_generator": "rooms", "height": 24, "width": 40}, id="rooms-static"),
-    pytest.param({"map_generator": "rooms", "height": 30, "width": 22, "map_mode": "dynamic",
-                  "teammates": "positions"}, id="rooms-dynamic"),
+    pytest.param(
+        {
+            "map_generator": "rooms",
+            "height": 30,
+            "width": 22,
+            "map_mode": "dynamic",
+            "teammates": "positions",
+        },
+        id="rooms-dynamic",
+    ),
 ]
 
 

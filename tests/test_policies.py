@@ -207,7 +207,11 @@ def test_heuristic_drives_the_gymnasium_env():
     # explore_threshold < 1 so that the episode ends before the last frontier vanishes (see
     # test_evaluation.py::test_fully_known_map_gives_exact_numbers for that case).
     env = gym.make(
-        frontier_marl.GYM_ID, height=8, width=8, obstacle_prob=0.1, perception_range=2,
+        frontier_marl.GYM_ID,
+        height=8,
+        width=8,
+        obstacle_prob=0.1,
+        perception_range=2,
         explore_threshold=0.8,
     )
     policy = make_policy("cost-utility")

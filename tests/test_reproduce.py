@@ -32,8 +32,20 @@ def reproduced(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
         mp.chdir(elsewhere)  # not the repository: the config must still be found
         stdout = io.StringIO()
         with contextlib.redirect_stdout(stdout):
-            code = main(["reproduce", "--steps", str(STEPS), "--episodes", str(EPISODES),
-                         "--out", str(out), "--seed", "1", "--no-progress"])
+            code = main(
+                [
+                    "reproduce",
+                    "--steps",
+                    str(STEPS),
+                    "--episodes",
+                    str(EPISODES),
+                    "--out",
+                    str(out),
+                    "--seed",
+                    "1",
+                    "--no-progress",
+                ]
+            )
     assert code == 0, stdout.getvalue()
     return out, stdout.getvalue()
 
@@ -41,8 +53,14 @@ def reproduced(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
 def test_reproduce_writes_table_figures_and_run(reproduced: tuple[Path, str]) -> None:
     out, _stdout = reproduced
     run_dir = out / "config01_seed1"
-    for name in ("comparison.md", "comparison.json", "comparison_rewards.png",
-                 "comparison_actions.png", "learning_curve.png", "baselines.json"):
+    for name in (
+        "comparison.md",
+        "comparison.json",
+        "comparison_rewards.png",
+        "comparison_actions.png",
+        "learning_curve.png",
+        "baselines.json",
+    ):
         path = out / name
         assert path.is_file() and path.stat().st_size > 0, name
     for name in ("model.zip", "model.json", "evaluation.json", "actions.png"):
@@ -66,9 +84,10 @@ def test_reproduce_json_has_dqn_and_heuristic_rows_with_thesis_figures(
     assert sum(dqn["action_shares"]) == pytest.approx(1.0)
     assert isinstance(dqn["degenerate"], bool)
     assert (rows["greedy-distance"]["thesis_mean"], rows["greedy-distance"]["thesis_std"]) == (
-        16.48, 1.78)
-    assert (rows["greedy-gain"]["thesis_mean"], rows["greedy-gain"]["thesis_std"]) == (
-        15.01, 1.12)
+        16.48,
+        1.78,
+    )
+    assert (rows["greedy-gain"]["thesis_mean"], rows["greedy-gain"]["thesis_std"]) == (15.01, 1.12)
     assert rows["cost-utility"]["thesis_mean"] is None
     assert rows["random"]["thesis_mean"] is None
     for name in HEURISTICS:
@@ -78,8 +97,11 @@ def test_reproduce_json_has_dqn_and_heuristic_rows_with_thesis_figures(
     assert table["training"]["seed"] == 1
     assert table["setting"]["map_mode"] == "static"
     assert table["setting"]["seeds"] == [0, EPISODES - 1]
-    assert set(table["checks"]) == {"max_share_at_most_70pct", "three_actions_above_2pct",
-                                    "mean_at_least_13.1"}
+    assert set(table["checks"]) == {
+        "max_share_at_most_70pct",
+        "three_actions_above_2pct",
+        "mean_at_least_13.1",
+    }
     assert table["summary"]["config"] == "config01"
     assert table["summary"]["mean_reward"] == pytest.approx(dqn["mean_reward"])
 
@@ -99,8 +121,15 @@ def test_heuristics_ran_on_the_dqn_evaluation_episodes(reproduced: tuple[Path, s
 def test_reproduce_prints_table_and_summary_with_paths(reproduced: tuple[Path, str]) -> None:
     out, stdout = reproduced
     markdown = (out / "comparison.md").read_text()
-    for text in ("15.55 ± 2.45", "16.48 ± 1.78", "15.01 ± 1.12", "25/30",
-                 "50.6/25.4/21.2/2.8 %", "| DQN config01 |", "| random |"):
+    for text in (
+        "15.55 ± 2.45",
+        "16.48 ± 1.78",
+        "15.01 ± 1.12",
+        "25/30",
+        "50.6/25.4/21.2/2.8 %",
+        "| DQN config01 |",
+        "| random |",
+    ):
         assert text in markdown, text
         assert text in stdout, text
     assert "Summary" in stdout
@@ -126,7 +155,9 @@ def test_reproduce_refuses_existing_run_then_resumes(
     assert all(row["episodes"] == 1 for row in table["rows"])
     sessions = json.loads((copy / "config01_seed1" / "run.json").read_text())["sessions"]
     assert [(s["start_step"], s["end_step"]) for s in sessions] == [
-        (0, STEPS), (STEPS, STEPS + 400)]
+        (0, STEPS),
+        (STEPS, STEPS + 400),
+    ]
 
 
 @pytest.mark.parametrize(
@@ -139,8 +170,9 @@ def test_reproduce_rejects_bad_input(kwargs: dict, name: str, tmp_path: Path) ->
     assert not any(tmp_path.iterdir())
 
 
-def test_config_names_resolve_from_any_directory(tmp_path: Path,
-                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+def test_config_names_resolve_from_any_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from frontier_marl.training.experiment import config_folders, resolve_config_path
 
     monkeypatch.chdir(tmp_path)

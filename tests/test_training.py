@@ -251,8 +251,15 @@ def finished_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object
 def test_run_produces_model_logs_checkpoints_and_evaluation(finished_run: tuple) -> None:
     run_dir, result = finished_run
     assert result.num_timesteps == 1200 and not result.interrupted
-    for name in ("model.zip", "model.json", "evaluation.json", "actions.png",
-                 "learning_curve.png", "metrics.jsonl", "run.json"):
+    for name in (
+        "model.zip",
+        "model.json",
+        "evaluation.json",
+        "actions.png",
+        "learning_curve.png",
+        "metrics.jsonl",
+        "run.json",
+    ):
         assert (run_dir / name).is_file(), name
     meta = json.loads((run_dir / "model.json").read_text())
     assert meta["observation_layout"]["centroid"] == "absolute"
@@ -329,8 +336,12 @@ def test_resume_continues_step_count_and_replay_buffer(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="already holds a run"):
         train(experiment, run_dir, progress_bar=False)
 
-    resumed = train(resume_experiment(checkpoint, {"total_timesteps": 1000}), run_dir,
-                    resume=checkpoint, progress_bar=False)
+    resumed = train(
+        resume_experiment(checkpoint, {"total_timesteps": 1000}),
+        run_dir,
+        resume=checkpoint,
+        progress_bar=False,
+    )
     assert not resumed.interrupted
     assert resumed.num_timesteps == 1000
     assert resumed.steps_this_session == 300
@@ -404,11 +415,20 @@ def test_flat_observations_use_mlp_policy(tmp_path: Path) -> None:
     experiment = experiment_from_dict(
         {
             "name": "flat",
-            "env": {**SMALL, "centroid": "relative", "agent_position": False,
-                    "sort_by_distance": True, "reward": "reward1"},
+            "env": {
+                **SMALL,
+                "centroid": "relative",
+                "agent_position": False,
+                "sort_by_distance": True,
+                "reward": "reward1",
+            },
             "dqn": {"learning_starts": 50},
-            "train": {"total_timesteps": 300, "checkpoint_every": 0, "eval_episodes": 1,
-                      "n_envs": 2},
+            "train": {
+                "total_timesteps": 300,
+                "checkpoint_every": 0,
+                "eval_episodes": 1,
+                "n_envs": 2,
+            },
         }
     )
     result = train(experiment, tmp_path / "flat", progress_bar=False)

@@ -84,27 +84,56 @@ def parse_set_options(items: Sequence[str] | None) -> dict[str, Any]:
 def add_env_arguments(parser: argparse.ArgumentParser) -> None:
     """``--preset --map --map-generator --map-mode --seed --agents --set`` (shared by
     ``baselines`` and ``gif``)."""
-    parser.add_argument("--preset", choices=sorted(PRESETS), default="thesis-20x20",
-                        help="thesis geometry (default: %(default)s)")
+    parser.add_argument(
+        "--preset",
+        choices=sorted(PRESETS),
+        default="thesis-20x20",
+        help="thesis geometry (default: %(default)s)",
+    )
     from frontier_marl.example_maps import example_map_names
 
-    parser.add_argument("--map", default=None, metavar="PATH",
-                        help="load the layout from a .txt, .pgm or .png file, or name an "
-                        f"example map ({', '.join(example_map_names())}); the file sets the "
-                        "size and the map is static")
-    parser.add_argument("--map-generator", choices=["random", "rooms"], default=None,
-                        help="random obstacles or rooms and corridors (default: the preset's)")
-    parser.add_argument("--map-mode", choices=["static", "dynamic"], default=None,
-                        help="static: one layout from the config's map_seed; dynamic: a new "
-                        "layout per episode (default: the preset's)")
-    parser.add_argument("--seed", type=non_negative_int, default=0,
-                        help="episode i uses reset seed SEED + i (default: %(default)s)")
-    parser.add_argument("--agents", type=positive_int, default=1,
-                        help="robots sharing one belief (default: %(default)s)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[],
-                        metavar="KEY=VALUE",
-                        help="any other env parameter, e.g. --set cells_per_step=full "
-                        "--set sensor=raycast (repeatable)")
+    parser.add_argument(
+        "--map",
+        default=None,
+        metavar="PATH",
+        help="load the layout from a .txt, .pgm or .png file, or name an "
+        f"example map ({', '.join(example_map_names())}); the file sets the "
+        "size and the map is static",
+    )
+    parser.add_argument(
+        "--map-generator",
+        choices=["random", "rooms"],
+        default=None,
+        help="random obstacles or rooms and corridors (default: the preset's)",
+    )
+    parser.add_argument(
+        "--map-mode",
+        choices=["static", "dynamic"],
+        default=None,
+        help="static: one layout from the config's map_seed; dynamic: a new "
+        "layout per episode (default: the preset's)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative_int,
+        default=0,
+        help="episode i uses reset seed SEED + i (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--agents",
+        type=positive_int,
+        default=1,
+        help="robots sharing one belief (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="any other env parameter, e.g. --set cells_per_step=full "
+        "--set sensor=raycast (repeatable)",
+    )
 
 
 def env_kwargs_from_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -146,14 +175,31 @@ def fail(command: str, message: str) -> int:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_env_arguments(parser)
-    parser.add_argument("--episodes", type=positive_int, default=30,
-                        help="episodes per policy (default: %(default)s)")
-    parser.add_argument("--policies", default=DEFAULT_POLICIES,
-                        help="comma-separated heuristics (default: %(default)s)")
-    parser.add_argument("--json", type=Path, default=None, metavar="FILE",
-                        help="write the result rows (with per-episode records) as JSON")
-    parser.add_argument("--plot", type=Path, default=None, metavar="FILE",
-                        help="write a PNG: reward bars and coverage-vs-travel curves")
+    parser.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=30,
+        help="episodes per policy (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--policies",
+        default=DEFAULT_POLICIES,
+        help="comma-separated heuristics (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--json",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the result rows (with per-episode records) as JSON",
+    )
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write a PNG: reward bars and coverage-vs-travel curves",
+    )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
@@ -195,12 +241,20 @@ def run_baselines(
         == (base.height, base.width, base.perception_range)
     )
     rows = []
-    with tqdm(total=episodes * len(policies), disable=not progress, unit="ep",
-              file=sys.stderr, dynamic_ncols=True) as bar:
+    with tqdm(
+        total=episodes * len(policies),
+        disable=not progress,
+        unit="ep",
+        file=sys.stderr,
+        dynamic_ncols=True,
+    ) as bar:
         for name in policies:
             bar.set_description(name)
             result = evaluate(
-                dict(env_kwargs), make_policy(name, seed), episodes=episodes, seed=seed,
+                dict(env_kwargs),
+                make_policy(name, seed),
+                episodes=episodes,
+                seed=seed,
                 on_episode=lambda _i, _rec: bar.update(1),
             )
             row = result.to_dict()
@@ -238,7 +292,8 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
     for row in rows:
         n = row["episodes"]
         thesis = (
-            "—" if row.get("thesis_mean") is None
+            "—"
+            if row.get("thesis_mean") is None
             else f"{row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
         )
         cells = [_fmt_cells(row["cells_to_coverage"][key], n) for key in levels]
@@ -250,16 +305,18 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
                 _fmt_mean_std(row.get("mean_overlap"), row.get("std_overlap"), 3),
             ]
         shares = " ".join(f"{s:.2f}" for s in row["action_shares"])
-        lines.append([
-            row["policy"],
-            f"{row['mean_reward']:.2f} ± {row['std_reward']:.2f}",
-            thesis,
-            f"{row['terminations']}/{n}",
-            f"{row['mean_steps']:.1f}",
-            f"{row['mean_travelled']:.1f}",
-            *cells,
-            shares,
-        ])
+        lines.append(
+            [
+                row["policy"],
+                f"{row['mean_reward']:.2f} ± {row['std_reward']:.2f}",
+                thesis,
+                f"{row['terminations']}/{n}",
+                f"{row['mean_steps']:.1f}",
+                f"{row['mean_travelled']:.1f}",
+                *cells,
+                shares,
+            ]
+        )
     widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
     out = []
     for k, line in enumerate(lines):

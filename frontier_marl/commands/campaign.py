@@ -25,6 +25,7 @@ from pathlib import Path
 
 def _int_list(low: int) -> Callable[[str], list[int]]:
     """argparse type: comma-separated integers >= ``low`` (``1e6`` and ``1_000_000`` work)."""
+
     def parse(text: str) -> list[int]:
         values = []
         for item in text.split(","):
@@ -35,7 +36,8 @@ def _int_list(low: int) -> Callable[[str], list[int]]:
                 value = int(float(item)) if "e" in item.lower() else int(item)
             except ValueError:
                 raise argparse.ArgumentTypeError(
-                    f"expected comma-separated integers >= {low}, got {text!r}") from None
+                    f"expected comma-separated integers >= {low}, got {text!r}"
+                ) from None
             if value < low:
                 raise argparse.ArgumentTypeError(f"expected integers >= {low}, got {value}")
             values.append(value)
@@ -59,28 +61,70 @@ def _positive_float(text: str) -> float:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.commands.baselines import positive_int
 
-    parser.add_argument("--configs", default="config01", metavar="A,B,...",
-                        help="experiment configs: names under training/ or TOML paths "
-                        "(default: %(default)s)")
-    parser.add_argument("--seeds", type=_int_list(0), default=[0], metavar="S,S,...",
-                        help="training seeds (default: 0)")
-    parser.add_argument("--steps", type=_int_list(1), default=[1_000_000], metavar="N,N,...",
-                        help="training budgets (default: 1000000)")
-    parser.add_argument("--episodes", type=positive_int, default=30, metavar="N",
-                        help="evaluation episodes per run (default: %(default)s)")
-    parser.add_argument("--out", type=Path, default=Path("runs/campaign"), metavar="DIR",
-                        help="output folder (default: %(default)s)")
-    parser.add_argument("--address", default=None, metavar="ADDR",
-                        help="an existing Ray cluster ('auto', 'ray://host:10001'); "
-                        "default: start a local Ray instance")
-    parser.add_argument("--cpus-per-trial", type=_positive_float, default=1.0, metavar="C",
-                        help="CPUs Ray reserves per trial (default: %(default)s)")
-    parser.add_argument("--max-concurrent", type=positive_int, default=None, metavar="K",
-                        help="at most K trials at once (default: as many as the CPUs allow)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[],
-                        metavar="KEY=VALUE",
-                        help="override a config value in every experiment, as in "
-                        "'frontier-marl train --set' (repeatable)")
+    parser.add_argument(
+        "--configs",
+        default="config01",
+        metavar="A,B,...",
+        help="experiment configs: names under training/ or TOML paths (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--seeds",
+        type=_int_list(0),
+        default=[0],
+        metavar="S,S,...",
+        help="training seeds (default: 0)",
+    )
+    parser.add_argument(
+        "--steps",
+        type=_int_list(1),
+        default=[1_000_000],
+        metavar="N,N,...",
+        help="training budgets (default: 1000000)",
+    )
+    parser.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=30,
+        metavar="N",
+        help="evaluation episodes per run (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("runs/campaign"),
+        metavar="DIR",
+        help="output folder (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--address",
+        default=None,
+        metavar="ADDR",
+        help="an existing Ray cluster ('auto', 'ray://host:10001'); "
+        "default: start a local Ray instance",
+    )
+    parser.add_argument(
+        "--cpus-per-trial",
+        type=_positive_float,
+        default=1.0,
+        metavar="C",
+        help="CPUs Ray reserves per trial (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--max-concurrent",
+        type=positive_int,
+        default=None,
+        metavar="K",
+        help="at most K trials at once (default: as many as the CPUs allow)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config value in every experiment, as in "
+        "'frontier-marl train --set' (repeatable)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
@@ -107,15 +151,30 @@ def run(args: argparse.Namespace) -> int:
         return fail("campaign", str(exc))
     except ValueError as exc:
         return fail("campaign", str(exc))
-    columns = ("config", "seed", "steps", "mean_reward", "std_reward", "terminations",
-               "episodes", "action_shares", "degenerate", "thesis", "wall_time_s", "status")
+    columns = (
+        "config",
+        "seed",
+        "steps",
+        "mean_reward",
+        "std_reward",
+        "terminations",
+        "episodes",
+        "action_shares",
+        "degenerate",
+        "thesis",
+        "wall_time_s",
+        "status",
+    )
     print()
     print(format_markdown(result.rows, columns), end="")
-    print(f"\n{len(result.rows)} trial(s) in {result.wall_time_s:.0f} s, "
-          f"{len(result.failed)} failed")
+    print(
+        f"\n{len(result.rows)} trial(s) in {result.wall_time_s:.0f} s, {len(result.failed)} failed"
+    )
     for row in result.failed:
-        print(f"  FAILED {row['config']} seed {row['seed']} steps {row['steps']}: "
-              f"{row.get('error')}", file=sys.stderr)
+        print(
+            f"  FAILED {row['config']} seed {row['seed']} steps {row['steps']}: {row.get('error')}",
+            file=sys.stderr,
+        )
     for label, path in result.files.items():
         print(f"  {label + ':':<10} {path}")
     return 1 if result.failed else 0

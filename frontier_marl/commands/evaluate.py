@@ -26,29 +26,71 @@ from frontier_marl.config import PRESETS
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.commands.baselines import non_negative_int, positive_int
 
-    parser.add_argument("model", metavar="MODEL",
-                        help="model.zip, a run folder, a checkpoint folder, or a shipped "
-                        "model's name (thesis-config01)")
-    parser.add_argument("--episodes", type=positive_int, default=30,
-                        help="evaluation episodes (default: %(default)s)")
-    parser.add_argument("--map-mode", choices=["static", "dynamic"], default=None,
-                        help="map mode (default: the one the model was trained on)")
-    parser.add_argument("--seed", type=non_negative_int, default=0,
-                        help="episode i uses reset seed SEED + i (default: %(default)s)")
-    parser.add_argument("--preset", choices=sorted(PRESETS), default=None,
-                        help="evaluate on another geometry (default: the training env's)")
-    parser.add_argument("--agents", type=positive_int, default=None,
-                        help="robots sharing the belief; each acts with the shared-parameter "
-                        "model (default: as trained)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[],
-                        metavar="KEY=VALUE", help="any other env parameter (repeatable)")
-    parser.add_argument("--heuristics", default="greedy-distance",
-                        help="comma-separated heuristics run on the same episodes "
-                        "(default: %(default)s; empty for none)")
-    parser.add_argument("--json", type=Path, default=None, metavar="FILE",
-                        help="write the result (rows with per-episode records) as JSON")
-    parser.add_argument("--plot", type=Path, default=None, metavar="FILE",
-                        help="write the action histogram as a PNG")
+    parser.add_argument(
+        "model",
+        metavar="MODEL",
+        help="model.zip, a run folder, a checkpoint folder, or a shipped "
+        "model's name (thesis-config01)",
+    )
+    parser.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=30,
+        help="evaluation episodes (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--map-mode",
+        choices=["static", "dynamic"],
+        default=None,
+        help="map mode (default: the one the model was trained on)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative_int,
+        default=0,
+        help="episode i uses reset seed SEED + i (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=sorted(PRESETS),
+        default=None,
+        help="evaluate on another geometry (default: the training env's)",
+    )
+    parser.add_argument(
+        "--agents",
+        type=positive_int,
+        default=None,
+        help="robots sharing the belief; each acts with the shared-parameter "
+        "model (default: as trained)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="any other env parameter (repeatable)",
+    )
+    parser.add_argument(
+        "--heuristics",
+        default="greedy-distance",
+        help="comma-separated heuristics run on the same episodes "
+        "(default: %(default)s; empty for none)",
+    )
+    parser.add_argument(
+        "--json",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the result (rows with per-episode records) as JSON",
+    )
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the action histogram as a PNG",
+    )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
@@ -79,22 +121,32 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         return _fail(str(exc))
     if loaded.metadata is None:
-        print(f"note: {loaded.path} has no model.json metadata; evaluating on "
-              f"{args.preset or 'thesis-20x20'} with the given overrides", file=sys.stderr)
+        print(
+            f"note: {loaded.path} has no model.json metadata; evaluating on "
+            f"{args.preset or 'thesis-20x20'} with the given overrides",
+            file=sys.stderr,
+        )
 
     from tqdm import tqdm
 
     total = args.episodes * (1 + len(heuristics))
-    with tqdm(total=total, disable=args.no_progress, unit="ep", file=sys.stderr,
-              dynamic_ncols=True) as bar:
+    with tqdm(
+        total=total, disable=args.no_progress, unit="ep", file=sys.stderr, dynamic_ncols=True
+    ) as bar:
+
         def tick(label: str, _i: int) -> None:
             bar.set_description(label)
             bar.update(1)
 
         try:
             result = evaluate_model(
-                loaded, cfg, episodes=args.episodes, seed=args.seed, heuristics=heuristics,
-                name="model", on_episode=tick,
+                loaded,
+                cfg,
+                episodes=args.episodes,
+                seed=args.seed,
+                heuristics=heuristics,
+                name="model",
+                on_episode=tick,
             )
         except ModelEnvMismatchError as exc:
             bar.close()

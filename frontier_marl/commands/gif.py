@@ -27,17 +27,34 @@ from frontier_marl.commands.baselines import (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.policies import POLICIES
 
-    parser.add_argument("--policy", choices=list(POLICIES), default="greedy-distance",
-                        help="heuristic driving the robots (default: %(default)s)")
+    parser.add_argument(
+        "--policy",
+        choices=list(POLICIES),
+        default="greedy-distance",
+        help="heuristic driving the robots (default: %(default)s)",
+    )
     add_env_arguments(parser)
-    parser.add_argument("--out", type=Path, default=Path("episode.gif"),
-                        help="GIF file to write (default: %(default)s)")
-    parser.add_argument("--fps", type=float, default=4.0,
-                        help="frames per second (default: %(default)s)")
-    parser.add_argument("--cell-px", type=positive_int, default=12,
-                        help="pixels per grid cell (default: %(default)s)")
-    parser.add_argument("--max-steps", type=positive_int, default=None,
-                        help="stop after this many decisions (default: when the episode ends)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("episode.gif"),
+        help="GIF file to write (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--fps", type=float, default=4.0, help="frames per second (default: %(default)s)"
+    )
+    parser.add_argument(
+        "--cell-px",
+        type=positive_int,
+        default=12,
+        help="pixels per grid cell (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--max-steps",
+        type=positive_int,
+        default=None,
+        help="stop after this many decisions (default: when the episode ends)",
+    )
 
 
 def render_frame(env: Any, infos: dict[str, dict[str, Any]], cell_px: int) -> np.ndarray:
@@ -98,6 +115,8 @@ def run(args: argparse.Namespace) -> int:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     write_gif(frames, args.out, fps=args.fps)
     print(f"wrote {args.out}")
-    print(f"policy {args.policy}, seed {args.seed}: reward {reward:.2f}, {steps} steps, "
-          f"end: {reason or 'none'}")
+    print(
+        f"policy {args.policy}, seed {args.seed}: reward {reward:.2f}, {steps} steps, "
+        f"end: {reason or 'none'}"
+    )
     return 0

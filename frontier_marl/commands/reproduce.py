@@ -27,17 +27,40 @@ from pathlib import Path
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.commands.baselines import non_negative_int, positive_int
 
-    parser.add_argument("--steps", type=positive_int, default=1_000_000, metavar="N",
-                        help="training steps (default: %(default)s, the thesis's budget)")
-    parser.add_argument("--seed", type=non_negative_int, default=0, metavar="S",
-                        help="training seed (default: %(default)s)")
-    parser.add_argument("--out", type=Path, default=Path("runs/reproduce"), metavar="DIR",
-                        help="output folder (default: %(default)s)")
-    parser.add_argument("--episodes", type=positive_int, default=30, metavar="N",
-                        help="evaluation episodes, seeds 0..N-1 (default: %(default)s)")
-    parser.add_argument("--resume", action="store_true",
-                        help="continue the run in --out from its newest checkpoint (after "
-                        "Ctrl-C), or re-evaluate a finished one")
+    parser.add_argument(
+        "--steps",
+        type=positive_int,
+        default=1_000_000,
+        metavar="N",
+        help="training steps (default: %(default)s, the thesis's budget)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative_int,
+        default=0,
+        metavar="S",
+        help="training seed (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("runs/reproduce"),
+        metavar="DIR",
+        help="output folder (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=30,
+        metavar="N",
+        help="evaluation episodes, seeds 0..N-1 (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the run in --out from its newest checkpoint (after "
+        "Ctrl-C), or re-evaluate a finished one",
+    )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bars")
 
 
@@ -45,10 +68,12 @@ def _print_summary(result: object) -> None:
     table = result.table  # type: ignore[attr-defined]
     training = table["training"]
     print("\nSummary")
-    print(f"  {table['setting']['preset']}, {table['setting']['map_mode']} map, "
-          f"{table['setting']['episodes']} deterministic episodes; DQN trained "
-          f"{training['steps']} steps in {training['wall_time_s']:.0f} s "
-          f"({training['steps_per_second'] or 0:.0f} steps/s)")
+    print(
+        f"  {table['setting']['preset']}, {table['setting']['map_mode']} map, "
+        f"{table['setting']['episodes']} deterministic episodes; DQN trained "
+        f"{training['steps']} steps in {training['wall_time_s']:.0f} s "
+        f"({training['steps_per_second'] or 0:.0f} steps/s)"
+    )
     for row in table["rows"]:
         thesis = ""
         if row["thesis_mean"] is not None:
@@ -57,8 +82,10 @@ def _print_summary(result: object) -> None:
                 thesis += f", {row['thesis_terminations']}/{row['thesis_episodes']}"
             thesis += ")"
         flag = "  DEGENERATE" if row["degenerate"] else ""
-        print(f"  {row['policy']:<16} {row['mean_reward']:6.2f} ± {row['std_reward']:5.2f}, "
-              f"{row['terminations']}/{row['episodes']} terminations{flag}{thesis}")
+        print(
+            f"  {row['policy']:<16} {row['mean_reward']:6.2f} ± {row['std_reward']:5.2f}, "
+            f"{row['terminations']}/{row['episodes']} terminations{flag}{thesis}"
+        )
     checks = ", ".join(f"{k} {'ok' if v else 'FAIL'}" for k, v in table["checks"].items())
     print(f"  DQN checks: {checks}")
     print("Files")

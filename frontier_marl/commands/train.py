@@ -24,22 +24,52 @@ from typing import Any
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from frontier_marl.commands.baselines import non_negative_int, positive_int
 
-    parser.add_argument("config", nargs="?", default=None, metavar="CONFIG",
-                        help="experiment TOML file, or its name under training/ (e.g. config01); "
-                        "optional with --resume")
-    parser.add_argument("--steps", type=positive_int, default=None, metavar="N",
-                        help="total environment steps (overrides train.total_timesteps)")
-    parser.add_argument("--seed", type=non_negative_int, default=None, metavar="S",
-                        help="training seed (overrides train.seed)")
-    parser.add_argument("--out", type=Path, default=None, metavar="DIR",
-                        help="run folder (default: runs/<name>/seed<seed>)")
-    parser.add_argument("--resume", type=Path, default=None, metavar="CHECKPOINT_OR_RUN_DIR",
-                        help="continue a run from a checkpoint folder or a run's newest "
-                        "checkpoint (step count and replay buffer included)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[],
-                        metavar="KEY=VALUE",
-                        help="override a config value: env.KEY, dqn.KEY or train.KEY "
-                        "(a bare KEY goes to the section that has it); repeatable")
+    parser.add_argument(
+        "config",
+        nargs="?",
+        default=None,
+        metavar="CONFIG",
+        help="experiment TOML file, or its name under training/ (e.g. config01); "
+        "optional with --resume",
+    )
+    parser.add_argument(
+        "--steps",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="total environment steps (overrides train.total_timesteps)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative_int,
+        default=None,
+        metavar="S",
+        help="training seed (overrides train.seed)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="run folder (default: runs/<name>/seed<seed>)",
+    )
+    parser.add_argument(
+        "--resume",
+        type=Path,
+        default=None,
+        metavar="CHECKPOINT_OR_RUN_DIR",
+        help="continue a run from a checkpoint folder or a run's newest "
+        "checkpoint (step count and replay buffer included)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config value: env.KEY, dqn.KEY or train.KEY "
+        "(a bare KEY goes to the section that has it); repeatable",
+    )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument("--verbose", action="store_true", help="print SB3's logger tables")
 

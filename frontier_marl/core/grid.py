@@ -19,4 +19,3 @@ BELIEF_DTYPE = np.int8
 def new_belief(shape: tuple[int, int]) -> np.ndarray:
     """An all-unknown belief grid of ``shape``."""
     return np.full(shape, UNKNOWN, dtype=BELIEF_DTYPE)
-

@@ -13,9 +13,7 @@ from collections import deque
 import numpy as np
 
 
-def astar(
-    passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
-) -> np.ndarray | None:
+def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -> np.ndarray | None:
     """A shortest 4-connected path from ``start`` to ``goal`` through passable cells.
 
     Args:

@@ -60,9 +60,7 @@ class MoveResult:
 class World:
     """Mutable state of one episode. Read it through the read-only array properties."""
 
-    def __init__(
-        self, true_grid: np.ndarray, starts: np.ndarray, params: WorldParams
-    ) -> None:
+    def __init__(self, true_grid: np.ndarray, starts: np.ndarray, params: WorldParams) -> None:
         true_grid = np.asarray(true_grid, dtype=bool)
         starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
         if true_grid[starts[:, 0], starts[:, 1]].any():
@@ -223,9 +221,7 @@ class World:
         for agent, target in enumerate(targets):
             path = None if target is None else self.plan(agent, target)
             remaining.append(path[1:] if path is not None else np.zeros((0, 2), np.int64))
-        walked: list[list[tuple[int, int]]] = [
-            [(int(r), int(c))] for r, c in self._positions
-        ]
+        walked: list[list[tuple[int, int]]] = [[(int(r), int(c))] for r, c in self._positions]
         new_cells = np.zeros(n, dtype=np.int64)
         budget = self.params.cells_per_step
         progress = [0] * n
@@ -236,8 +232,10 @@ class World:
             for agent in range(n):
                 if progress[agent] >= len(remaining[agent]):
                     continue
-                nxt = (int(remaining[agent][progress[agent], 0]),
-                       int(remaining[agent][progress[agent], 1]))
+                nxt = (
+                    int(remaining[agent][progress[agent], 0]),
+                    int(remaining[agent][progress[agent], 1]),
+                )
                 if nxt in occupied:
                     continue
                 occupied.discard(walked[agent][-1])

@@ -55,8 +55,14 @@ class ProgressBar(BaseCallback):
         total = int(self.locals["total_timesteps"])
         self._shown = self.model.num_timesteps
         self._next = self._shown + self.every
-        self.pbar = tqdm(total=total, initial=self._shown, unit="step", file=sys.stderr,
-                         dynamic_ncols=True, smoothing=0.05)
+        self.pbar = tqdm(
+            total=total,
+            initial=self._shown,
+            unit="step",
+            file=sys.stderr,
+            dynamic_ncols=True,
+            smoothing=0.05,
+        )
 
     def _on_step(self) -> bool:
         if self.model.num_timesteps >= self._next:

@@ -95,7 +95,6 @@ def find_checkpoint(path: str | Path) -> Checkpoint:
     checkpoints = list_checkpoints(path)
     if not checkpoints:
         raise ValueError(
-            f"--resume: no checkpoint in {str(path)!r} (expected {CHECKPOINTS}/step_*/"
-            f"{MODEL_FILE})"
+            f"--resume: no checkpoint in {str(path)!r} (expected {CHECKPOINTS}/step_*/{MODEL_FILE})"
         )
     return checkpoints[-1]

@@ -92,8 +92,12 @@ def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:
 def degeneracy(shares: Sequence[float], threshold: float = DEGENERACY_THRESHOLD) -> dict[str, Any]:
     """Whether one action takes more than ``threshold`` of all decisions."""
     if not shares:
-        return {"degenerate": False, "dominant_action": None, "dominant_share": 0.0,
-                "threshold": threshold}
+        return {
+            "degenerate": False,
+            "dominant_action": None,
+            "dominant_share": 0.0,
+            "threshold": threshold,
+        }
     top = max(range(len(shares)), key=lambda i: shares[i])
     return {
         "degenerate": bool(shares[top] > threshold),
@@ -137,7 +141,10 @@ def evaluate_model(
     rows = [model_row]
     for heuristic in heuristics:
         row = evaluate(
-            dict(env_kwargs), make_policy(heuristic, seed), episodes=episodes, seed=seed,
+            dict(env_kwargs),
+            make_policy(heuristic, seed),
+            episodes=episodes,
+            seed=seed,
             on_episode=progress(heuristic),
         ).to_dict()
         row["degeneracy"] = degeneracy(row["action_shares"])
@@ -169,9 +176,7 @@ def evaluation_env_config(
             base = make_config(preset)
             saved = env_config_from_metadata(loaded.metadata)
             # keep the model's observation/reward choices, take the preset's geometry
-            geometry = {
-                k: getattr(base, k) for k in ("height", "width", "perception_range")
-            }
+            geometry = {k: getattr(base, k) for k in ("height", "width", "perception_range")}
             return make_config(config=saved, **{**geometry, **overrides})
         return env_config_from_metadata(loaded.metadata, **overrides)
     return make_config(preset or "thesis-20x20", **overrides)

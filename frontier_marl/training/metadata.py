@@ -128,8 +128,9 @@ def check_compatible(
                     f"observation layout '{key}': model has {saved.get(key)!r}, "
                     f"env has {current.get(key)!r}"
                 )
-    model_obs, env_obs = describe_space(model_observation_space), describe_space(
-        env_observation_space
+    model_obs, env_obs = (
+        describe_space(model_observation_space),
+        describe_space(env_observation_space),
     )
     if model_obs != env_obs:
         problems.append(f"observation space: model expects {model_obs}, env gives {env_obs}")

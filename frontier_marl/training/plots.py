@@ -38,8 +38,13 @@ def plot_action_histogram(
             offset = (i - (len(rows) - 1) / 2) * width
             label = f"{row['policy']} ({row['mean_reward']:.2f} ± {row['std_reward']:.2f})"
             ax.bar(x + offset, shares, width, label=label, color=f"C{i}")
-        ax.axhline(DEGENERACY_THRESHOLD, color="C3", linestyle="--", linewidth=1,
-                   label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})")
+        ax.axhline(
+            DEGENERACY_THRESHOLD,
+            color="C3",
+            linestyle="--",
+            linewidth=1,
+            label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})",
+        )
         ax.set_xticks(x, [f"slot {k}" for k in x])
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("share of decisions")
@@ -90,8 +95,15 @@ def plot_learning_curve(
         for ax in (reward, loss, eps):
             ax.set_xlabel("environment steps")
             if not ax.lines:
-                ax.text(0.5, 0.5, "no data yet", ha="center", va="center",
-                        transform=ax.transAxes, color="0.5")
+                ax.text(
+                    0.5,
+                    0.5,
+                    "no data yet",
+                    ha="center",
+                    va="center",
+                    transform=ax.transAxes,
+                    color="0.5",
+                )
         if title:
             fig.suptitle(title, fontsize=10)
         fig.tight_layout()
@@ -122,13 +134,19 @@ def plot_action_comparison(
     try:
         width = 0.38
         ax.bar(x - width / 2, ours, width, color="C0", label=labels[0])
-        ax.bar(x + width / 2, ref, width, color="0.75", edgecolor="0.3", hatch="//",
-               label=labels[1])
+        ax.bar(
+            x + width / 2, ref, width, color="0.75", edgecolor="0.3", hatch="//", label=labels[1]
+        )
         for xs, values in ((x - width / 2, ours), (x + width / 2, ref)):
             for xi, value in zip(xs, values, strict=True):
                 ax.text(xi, value + 0.01, f"{value:.1%}", ha="center", va="bottom", fontsize=7)
-        ax.axhline(DEGENERACY_THRESHOLD, color="C3", linestyle="--", linewidth=1,
-                   label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})")
+        ax.axhline(
+            DEGENERACY_THRESHOLD,
+            color="C3",
+            linestyle="--",
+            linewidth=1,
+            label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})",
+        )
         ax.set_xticks(x, [f"slot {k}" for k in x])
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("share of decisions")

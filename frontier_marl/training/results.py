@@ -143,9 +143,9 @@ def run_summary(run_dir: str | Path) -> dict[str, Any]:
         raise ValueError(f"no evaluation.json in {str(run_dir)!r} (is the run finished?)")
     evaluation = json.loads(path.read_text())
     record_path = run_dir / "run.json"
-    experiment = json.loads(record_path.read_text()).get("experiment", {}) if (
-        record_path.is_file()
-    ) else {}
+    experiment = (
+        json.loads(record_path.read_text()).get("experiment", {}) if (record_path.is_file()) else {}
+    )
     config = evaluation.get("experiment") or experiment.get("name") or run_dir.name
     seed = experiment.get("train", {}).get("seed", 0)
     return summary_row(

@@ -223,8 +223,16 @@ def train(
     save_metadata(meta, run_dir / "model.json")
     files["model"] = model_path
     files["metadata"] = run_dir / "model.json"
-    _record_session(run_dir, experiment, start_step, model.num_timesteps, wall, cpu, interrupted,
-                    None if checkpoint is None else checkpoint.path)
+    _record_session(
+        run_dir,
+        experiment,
+        start_step,
+        model.num_timesteps,
+        wall,
+        cpu,
+        interrupted,
+        None if checkpoint is None else checkpoint.path,
+    )
     model.logger.close()
     vec_env.close()
 
@@ -240,8 +248,9 @@ def train(
     )
     _plot_learning_curve(run_dir, experiment, result)
     if not interrupted and settings.eval_episodes > 0:
-        result.evaluation = _final_evaluation(model, model_path, meta, cfg, settings, run_dir,
-                                              experiment, result)
+        result.evaluation = _final_evaluation(
+            model, model_path, meta, cfg, settings, run_dir, experiment, result
+        )
     return result
 
 
@@ -342,7 +351,10 @@ def _final_evaluation(
 
     loaded = LoadedModel(model=model, path=model_path, metadata=meta)
     evaluation = evaluate_model(
-        loaded, cfg, episodes=settings.eval_episodes, seed=settings.eval_seed,
+        loaded,
+        cfg,
+        episodes=settings.eval_episodes,
+        seed=settings.eval_seed,
         name=experiment.name,
     )
     evaluation["experiment"] = experiment.name
