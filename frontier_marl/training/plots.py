@@ -38,22 +38,27 @@ def plot_action_histogram(
             offset = (i - (len(rows) - 1) / 2) * width
             label = f"{row['policy']} ({row['mean_reward']:.2f} ± {row['std_reward']:.2f})"
             ax.bar(x + offset, shares, width, label=label, color=f"C{i}")
-        ax.axhline(
-            DEGENERACY_THRESHOLD,
-            color="C3",
-            linestyle="--",
-            linewidth=1,
-            label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})",
-        )
-        ax.set_xticks(x, [f"slot {k}" for k in x])
-        ax.set_ylim(0, 1.05)
-        ax.set_ylabel("share of decisions")
-        ax.legend(fontsize=8, loc="upper right")
-        ax.set_title(title or "actions chosen (deterministic evaluation)", fontsize=9)
+        _finish_share_axes(ax, x, title or "actions chosen (deterministic evaluation)")
         fig.tight_layout()
         fig.savefig(os.fspath(path), dpi=110)
     finally:
         plt.close(fig)
+
+
+def _finish_share_axes(ax: Any, x: np.ndarray, title: str) -> None:
+    """Degeneracy line, slot ticks, labels and legend of an action-share bar chart."""
+    ax.axhline(
+        DEGENERACY_THRESHOLD,
+        color="C3",
+        linestyle="--",
+        linewidth=1,
+        label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})",
+    )
+    ax.set_xticks(x, [f"slot {k}" for k in x])
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("share of decisions")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(title, fontsize=9)
 
 
 def _series(rows: Sequence[Mapping[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -140,18 +145,7 @@ def plot_action_comparison(
         for xs, values in ((x - width / 2, ours), (x + width / 2, ref)):
             for xi, value in zip(xs, values, strict=True):
                 ax.text(xi, value + 0.01, f"{value:.1%}", ha="center", va="bottom", fontsize=7)
-        ax.axhline(
-            DEGENERACY_THRESHOLD,
-            color="C3",
-            linestyle="--",
-            linewidth=1,
-            label=f"degeneracy threshold ({DEGENERACY_THRESHOLD:.0%})",
-        )
-        ax.set_xticks(x, [f"slot {k}" for k in x])
-        ax.set_ylim(0, 1.05)
-        ax.set_ylabel("share of decisions")
-        ax.legend(fontsize=8, loc="upper right")
-        ax.set_title(title or "action shares", fontsize=9)
+        _finish_share_axes(ax, x, title or "action shares")
         fig.tight_layout()
         fig.savefig(os.fspath(path), dpi=110)
     finally:
