@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_keys, make_config
+from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
 
 #: The thesis's final DQN hyperparameters (SPEC section 5); everything else is SB3's default.
 THESIS_DQN: dict[str, Any] = {
@@ -159,6 +160,9 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         if not isinstance(data.get(section, {}), Mapping):
             raise ValueError(f"[{section}] must be a table{where}")
     env = dict(data.get("env", {}))
+    map_name = env.get("map_path")
+    if isinstance(map_name, str) and map_name in EXAMPLE_MAPS:  # e.g. "rooms-64"
+        env["map_path"] = str(example_map_path(map_name))  # a shipped example map by name
     dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
     train_kw = dict(data.get("train", {}))
     bad_train = set(train_kw) - _TRAIN_KEYS
