@@ -113,11 +113,12 @@ def _split_oversized(
         for piece in split_cells(rows[members], cols[members], max_cells)[1:]:
             label[members[piece]] = next_label
             next_label += 1
-    # Cells are in raster order, so a piece's first occurrence is its first cell.
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    return rank[inverse.ravel()]
+    # Cells are in raster order, so a piece's first cell is its smallest position.
+    first = np.full(next_label, len(label), dtype=np.int64)
+    np.minimum.at(first, label, np.arange(len(label)))
+    rank = np.empty(next_label, dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(next_label)
+    return rank[label]
 
 
 def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.ndarray]:
