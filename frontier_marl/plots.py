@@ -83,32 +83,9 @@ def plot_baselines(
         bars.axhline(0.0, color="0.5", linewidth=0.8)
         bars.set_title("total reward (in bar: episodes reaching the threshold)", fontsize=9)
 
-        for i, row in enumerate(rows):
-            episode_curves = [
-                np.asarray(ep["curve"], dtype=float)
-                for ep in row.get("per_episode", [])
-                if ep.get("curve")
-            ]
-            if not episode_curves:
-                continue
-            grid, mean, std = mean_curve(episode_curves)
-            curves.plot(grid, mean, color=colours[i], label=names[i])
-            curves.fill_between(
-                grid,
-                np.clip(mean - std, 0, 1),
-                np.clip(mean + std, 0, 1),
-                color=colours[i],
-                alpha=0.18,
-                linewidth=0,
-            )
-        for level in (0.90, 0.99):
-            curves.axhline(level, color="0.6", linestyle=":", linewidth=0.8)
+        _coverage_panel(curves, rows, "curve", colours, names)
         curves.set_xlabel("cells travelled (team total)")
-        curves.set_ylabel("coverage of the reachable free region")
-        curves.set_ylim(0.0, 1.02)
         curves.set_title("coverage vs travel (mean ± std over episodes)", fontsize=9)
-        if curves.lines:
-            curves.legend(loc="lower right", fontsize=8)
         if team:
             _coverage_panel(axes[2], rows, "makespan_curve", colours)
             axes[2].set_xlabel("longest single robot path (cells) = time")
