@@ -31,6 +31,22 @@ from frontier_marl.rewards import OscillationDetector, StepEvents, step_outcome
 Observation = np.ndarray | dict[str, np.ndarray]
 
 
+class StepInfo(dict):  # type: ignore[type-arg]
+    """One robot's info dict. ``copy.deepcopy`` of it is a shallow copy.
+
+    SB3's ``DummyVecEnv`` deep-copies every info on every step, in case an env reuses and
+    mutates them. This env never does: each step builds fresh values (arrays, tuples, lists of
+    fresh dicts) and never touches them again, so a shallow copy is as safe. It costs ~1 µs
+    where a real deep copy of this info costs ~100 µs, more than the rest of the step.
+    Treat the values as read-only.
+    """
+
+    __slots__ = ()
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> StepInfo:
+        return StepInfo(self)
+
+
 @dataclass(frozen=True)
 class Transition:
     """Result of one decision step for all robots (lists are indexed by robot)."""
@@ -56,6 +72,8 @@ class ExplorationMDP:
             gain=cfg.gain,
         )
         self._static_map: np.ndarray | None = None
+        self._region_grid: np.ndarray | None = None  # the grid _start_region belongs to
+        self._start_region = np.zeros((0, 0), dtype=bool)
         self.world: World | None = None
         self._slots: list[SlotTable] = []
         self._oscillation: list[OscillationDetector] = []
@@ -89,8 +107,13 @@ class ExplorationMDP:
         """Start an episode: map, start cells in the largest free component, first sensing."""
         cfg = self.cfg
         true_grid = self.true_grid_for_episode(rng)
-        starts = sample_start_cells(largest_free_component(true_grid), cfg.n_agents, rng)
-        self.world = World(true_grid, starts, self.params)  # World makes it read-only
+        if true_grid is not self._region_grid:  # a static map keeps its start region
+            self._region_grid = true_grid
+            self._start_region = largest_free_component(true_grid)
+            self._start_region.setflags(write=False)
+        starts = sample_start_cells(self._start_region, cfg.n_agents, rng)
+        # Starts lie in one 4-connected component, so it is the region reachable from them.
+        self.world = World(true_grid, starts, self.params, self._start_region)
         self._oscillation = [
             OscillationDetector(cfg.reward.oscillation_window) for _ in range(cfg.n_agents)
         ]
@@ -101,9 +124,7 @@ class ExplorationMDP:
         self._refresh_slots()
         n = cfg.n_agents
         empty_paths = [self.world.positions[i][None, :].copy() for i in range(n)]
-        infos = self._infos(
-            np.zeros(n, np.int64), empty_paths, [None] * n, np.zeros(n, bool), np.zeros(n, bool), ""
-        )
+        infos = self._infos([0] * n, empty_paths, [None] * n, [False] * n, [False] * n, "")
         return self._observations(), infos
 
     def step(self, actions: list[Any]) -> Transition:
@@ -115,49 +136,51 @@ class ExplorationMDP:
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
         targets: list[tuple[int, int] | None] = []
-        padding = np.zeros(n, dtype=bool)
+        padding: list[bool] = []
         for agent, action in enumerate(actions):
             slot = self._check_action(action, agent)
             table = self._slots[agent]
-            if table.valid[slot]:
+            if slot < table.live:  # live slots come first
                 row, col = table.target[slot]
                 targets.append((int(row), int(col)))
+                padding.append(False)
             else:
                 targets.append(None)
-                padding[agent] = table.live > 0
-        oscillation = np.array(
-            [detector.update(t) for detector, t in zip(self._oscillation, targets, strict=True)]
-        )
-        moved = self.world.move(targets)
+                padding.append(table.live > 0)
+        oscillation = [
+            detector.update(t) for detector, t in zip(self._oscillation, targets, strict=True)
+        ]
+        world = self.world
+        moved = world.move(targets)
         self._targets = [
             None if target is None or reached else target
-            for target, reached in zip(targets, moved.reached, strict=True)
+            for target, reached in zip(targets, moved.reached.tolist(), strict=True)
         ]
         self.steps += 1
-        revealed = int(moved.new_cells.sum())
-        self.steps_without_progress = 0 if revealed else self.steps_without_progress + 1
+        new_cells = moved.new_cells.tolist()
+        self.steps_without_progress = 0 if any(new_cells) else self.steps_without_progress + 1
         self._refresh_slots()
-        fraction = self.world.explored_fraction(cfg.reward.threshold_basis)
+        fraction = world.explored_fraction(cfg.reward.threshold_basis)
         events = StepEvents(
-            new_cells=moved.new_cells,
+            new_cells=new_cells,
             padding=padding,
             oscillation=oscillation,
             threshold_reached=fraction >= cfg.reward.explore_threshold,
-            no_frontier_left=all(table.live == 0 for table in self._slots),
+            no_frontier_left=not any(table.live for table in self._slots),
             steps_taken=self.steps,
             steps_without_progress=self.steps_without_progress,
         )
         outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
-        infos = self._infos(
-            moved.new_cells, moved.paths, targets, padding, oscillation, outcome.reason
-        )
+        infos = self._infos(new_cells, moved.paths, targets, padding, oscillation, outcome.reason)
         return Transition(
             self._observations(), outcome.rewards, outcome.terminated, outcome.truncated, infos
         )
 
     # ------------------------------------------------------------------ helpers
     def _check_action(self, action: Any, agent: int) -> int:
+        if type(action) is int and 0 <= action < self.cfg.n_slots:  # the common case, fast
+            return action
         value = action
         if isinstance(value, np.ndarray):
             if value.size != 1:
@@ -221,11 +244,11 @@ class ExplorationMDP:
 
     def _infos(
         self,
-        new_cells: np.ndarray,
+        new_cells: list[int],
         paths: list[np.ndarray],
         targets: list[tuple[int, int] | None],
-        padding: np.ndarray,
-        oscillation: np.ndarray,
+        padding: list[bool],
+        oscillation: list[bool],
         reason: str,
     ) -> list[dict[str, Any]]:
         assert self.world is not None
@@ -234,14 +257,8 @@ class ExplorationMDP:
         coverage = world.explored_fraction("reachable")
         positions = world.positions.tolist()
         travelled = world.travelled.tolist()
-        new_list, padding_list, oscillation_list = (
-            new_cells.tolist(),
-            padding.tolist(),
-            oscillation.tolist(),
-        )
         infos = []
         for agent, table in enumerate(self._slots):
-            live = table.live  # live slots come first
             clusters = [
                 {
                     "slot": slot,
@@ -252,32 +269,31 @@ class ExplorationMDP:
                     "gain": gain,
                     "distance": distance,
                 }
-                for slot, cluster, centroid, target, size, gain, distance in zip(
-                    range(live),
-                    table.cluster[:live].tolist(),
-                    table.centroid[:live].tolist(),
-                    table.target[:live].tolist(),
-                    table.size[:live].tolist(),
-                    table.gain[:live].tolist(),
-                    table.distance[:live].tolist(),
-                    strict=True,
+                for slot, cluster, centroid, target, size, gain, distance in zip(  # noqa: B905
+                    range(table.live),  # the shortest: zip stops after the live slots
+                    table.cluster.tolist(),
+                    table.centroid.tolist(),
+                    table.target.tolist(),
+                    table.size.tolist(),
+                    table.gain.tolist(),
+                    table.distance.tolist(),
                 )
             ]
             infos.append(
-                {
-                    "explored_fraction": fraction,
-                    "coverage": coverage,
-                    "new_cells": new_list[agent],
-                    "action_mask": table.action_mask(),
-                    "clusters": clusters,
-                    "path": paths[agent],
-                    "target": targets[agent],
-                    "position": tuple(positions[agent]),
-                    "travelled": travelled[agent],
-                    "padding": padding_list[agent],
-                    "oscillation": oscillation_list[agent],
-                    "step": self.steps,
-                    "end_reason": reason,
-                }
+                StepInfo(
+                    explored_fraction=fraction,
+                    coverage=coverage,
+                    new_cells=new_cells[agent],
+                    action_mask=table.action_mask(),
+                    clusters=clusters,
+                    path=paths[agent],
+                    target=targets[agent],
+                    position=tuple(positions[agent]),
+                    travelled=travelled[agent],
+                    padding=padding[agent],
+                    oscillation=oscillation[agent],
+                    step=self.steps,
+                    end_reason=reason,
+                )
             )
         return infos

@@ -42,6 +42,7 @@ class ObservationEncoder:
         self.action_mask = obs.action_mask
         self.is_dict = obs.is_dict
         self.teammates = obs.teammates
+        self.normalize = obs.normalize
         height, width = cfg.height, cfg.width
         cells = cfg.max_cluster_cells
         gain_high = min(float(cells if cfg.gain == "size" else 8 * cells), float(height * width))
@@ -99,7 +100,8 @@ class ObservationEncoder:
         ``teammates`` is (N-1, 2) or (N-1, 4): the other robots' (row, col) positions, and
         targets for ``positions+targets``; needed only when the layout includes teammates.
         """
-        features = np.zeros((self.n_slots, self.features_per_slot), dtype=np.float64)
+        dtype = np.float64 if self.normalize else np.float32  # normalize in float64
+        features = np.zeros((self.n_slots, self.features_per_slot), dtype=dtype)
         k = slots.live
         column = 0
         if self.centroid == "absolute":
@@ -113,12 +115,18 @@ class ObservationEncoder:
             column = 1
         if self.info_gain:
             features[:k, column] = slots.gain[:k]
-        flat = (features / self._scale).astype(np.float32).ravel()
+        if self.normalize:
+            features = (features / self._scale).astype(np.float32)
+        flat = features.ravel()
         if not self.is_dict:
             return flat
         out: dict[str, np.ndarray] = {"clusters": flat}
         if self.agent_position:
-            out["agent_position"] = (position / self._position_scale).astype(np.float32)
+            out["agent_position"] = (
+                (position / self._position_scale).astype(np.float32)
+                if self.normalize
+                else position.astype(np.float32)
+            )
         if self.action_mask:
             out["action_mask"] = slots.action_mask()
         if self.teammates != "none":

@@ -27,6 +27,7 @@ penalty. The episode also terminates when no robot has a reachable frontier left
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,20 +56,20 @@ class OscillationDetector:
         return bool(oscillates)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class StepEvents:
-    """What happened in one decision step, per robot (arrays of length N) and for the team."""
+    """What happened in one decision step, per robot (sequences of length N) and for the team."""
 
-    new_cells: np.ndarray  # int
-    padding: np.ndarray  # bool, chose a padding slot while a live slot existed
-    oscillation: np.ndarray  # bool
+    new_cells: Sequence[int]
+    padding: Sequence[bool]  # chose a padding slot while a live slot existed
+    oscillation: Sequence[bool]
     threshold_reached: bool
     no_frontier_left: bool
     steps_taken: int  # decision steps so far, this one included
     steps_without_progress: int  # consecutive, this one included
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class StepOutcome:
     rewards: np.ndarray  # float (N,)
     terminated: bool
@@ -81,14 +82,10 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
     padding = cfg.padding
     oscillation = cfg.oscillation_penalty if cfg.kind == "reward2" else 0.0
     weight = cfg.team_weight
-    team = int(events.new_cells.sum())
+    new_cells = [int(new) for new in events.new_cells]
+    team = sum(new_cells)
     values = []
-    for new, pad, osc in zip(
-        events.new_cells.tolist(),
-        events.padding.tolist(),
-        events.oscillation.tolist(),
-        strict=True,
-    ):
+    for new, pad, osc in zip(new_cells, events.padding, events.oscillation, strict=True):
         credited = (1.0 - weight) * new + weight * team if weight else new
         value = cfg.cell_reward * credited
         if new == 0:
@@ -104,7 +101,7 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
     if events.no_frontier_left:
         return StepOutcome(rewards, True, False, "no_frontier")
     reasons = []
-    if cfg.padding_truncates and events.padding.any():
+    if cfg.padding_truncates and any(events.padding):
         reasons.append("padding")
     if events.steps_without_progress >= cfg.no_progress_limit:
         rewards = rewards + cfg.no_progress_penalty

@@ -5,6 +5,9 @@ are grouped into clusters of contiguous cells (4- or 8-connectivity); a cluster 
 ``max_cells`` cells is split recursively in two across the longer side of its bounding box
 (at the box's midpoint) until every piece is small enough. Clusters are numbered in raster
 order of their first cell, the same convention as ``scipy.ndimage.label``.
+
+With numba (see :mod:`frontier_marl.core.kernels`) the loops around the labelling run compiled,
+with identical results; the labelling is ``scipy.ndimage.label`` in both modes.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from frontier_marl.core import kernels
 from frontier_marl.core.grid import FREE, UNKNOWN
 
 _STRUCTURES = {
@@ -79,16 +83,23 @@ def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int 
     """
     if connectivity not in _STRUCTURES:
         raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
-    mask = frontier_mask(belief)
-    flat = np.flatnonzero(mask)
-    if flat.size == 0:
+    if kernels.ENABLED:
+        mask, rows, cols = kernels.frontier_cells(belief)
+    else:
+        mask = frontier_mask(belief)
+        rows, cols = np.divmod(np.flatnonzero(mask), belief.shape[1])
+    if rows.size == 0:
         empty = np.zeros(0, dtype=np.int64)
         return Clusters(belief.shape, empty, empty, empty, empty, np.zeros((0, 2)))
-    rows, cols = np.divmod(flat, belief.shape[1])
     image, count = ndimage.label(mask, structure=_STRUCTURES[connectivity])
+    if kernels.ENABLED:
+        cluster, sizes, centroids = kernels.clusters_from_labels(
+            image, rows, cols, count, max_cells
+        )
+        return Clusters(belief.shape, rows, cols, cluster, sizes, centroids)
     # ndimage numbers features in raster order of their first cell, so label - 1 is already
     # the cluster index unless splitting adds pieces.
-    cluster = image.ravel()[flat].astype(np.int64) - 1
+    cluster = image[rows, cols].astype(np.int64) - 1
     if max_cells > 0:
         cluster = _split_oversized(rows, cols, cluster, count, max_cells)
     sizes = np.bincount(cluster)
@@ -179,6 +190,18 @@ def nearest_cells_to_centroids(
     Returns:
         ``(has_target, targets)``: bool (K,), and int (K, 2) cells (rows of -1 where none).
     """
+    if kernels.ENABLED:
+        return kernels.nearest_targets(
+            clusters.cell_rows,
+            clusters.cell_cols,
+            clusters.cell_cluster,
+            clusters.centroids,
+            np.asarray(eligible, dtype=bool),
+        )
+    return _nearest_cells_numpy(clusters, eligible)
+
+
+def _nearest_cells_numpy(clusters: Clusters, eligible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     count = clusters.count
     targets = np.full((count, 2), -1, dtype=np.int64)
     has_target = np.zeros(count, dtype=bool)

@@ -1,7 +1,8 @@
 """Grid path planning: A* (4-connected, unit cost, Euclidean heuristic) and BFS distance fields.
 
 The Euclidean heuristic never overestimates the 4-connected path length and is consistent,
-so A* returns a shortest path whenever one exists.
+so A* returns a shortest path whenever one exists. With numba, :func:`astar` runs the compiled
+``kernels.astar_path``, which expands the same cells in the same order.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ import math
 from collections import deque
 
 import numpy as np
+
+from frontier_marl.core import kernels
 
 
 def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -> np.ndarray | None:
@@ -25,6 +28,19 @@ def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -
         is unreachable (or not passable).
     """
     passable = np.asarray(passable, dtype=bool)
+    if kernels.ENABLED:
+        path = kernels.astar_path(
+            passable, True, int(start[0]), int(start[1]), int(goal[0]), int(goal[1])
+        )
+        return path if len(path) else None
+    return astar_python(passable, start, goal)
+
+
+def astar_python(
+    passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
+) -> np.ndarray | None:
+    """The pure-Python :func:`astar` (the reference of ``kernels.astar_path``)."""
+    passable = np.asarray(passable, dtype=bool)
     height, width = passable.shape
     s_row, s_col = int(start[0]), int(start[1])
     g_row, g_col = int(goal[0]), int(goal[1])
@@ -34,11 +50,11 @@ def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -
     if source == target:
         return np.array([[s_row, s_col]], dtype=np.int64)
     free = passable.tobytes()
-    hypot = math.hypot
+    sqrt = math.sqrt  # of an exact integer: the same heuristic value as the kernel's
     cost = {source: 0}
     parent = {source: -1}
     # Entries are (f, -g, cell): among equal f, deeper nodes first (fewer expansions).
-    heap = [(hypot(s_row - g_row, s_col - g_col), 0, source)]
+    heap = [(sqrt((s_row - g_row) ** 2 + (s_col - g_col) ** 2), 0, source)]
     pop, push = heapq.heappop, heapq.heappush
     while heap:
         _, neg_g, cell = pop(heap)
@@ -60,7 +76,8 @@ def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -
             if g_next < cost.get(neighbour, 1 << 60):
                 cost[neighbour] = g_next
                 parent[neighbour] = cell
-                push(heap, (g_next + hypot(n_row - g_row, n_col - g_col), -g_next, neighbour))
+                h = sqrt((n_row - g_row) ** 2 + (n_col - g_col) ** 2)
+                push(heap, (g_next + h, -g_next, neighbour))
     return None
 
 

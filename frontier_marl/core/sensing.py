@@ -15,6 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
+from frontier_marl.core import kernels
 from frontier_marl.core.grid import UNKNOWN
 
 
@@ -118,6 +119,8 @@ class RaycastSensor:
         seen: np.ndarray | None = None,
     ) -> int:
         rows, cols = self.visible_cells(true_grid, cell)
+        if kernels.ENABLED and seen is not None:
+            return int(kernels.reveal(true_grid, belief, seen, rows, cols))
         if seen is not None:
             seen[rows, cols] = True
         unknown = belief[rows, cols] == UNKNOWN

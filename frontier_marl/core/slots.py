@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from frontier_marl.core import kernels
+
 
 @dataclass(frozen=True)
 class SlotTable:
@@ -32,15 +34,12 @@ class SlotTable:
     size: np.ndarray  # int (n,)
     gain: np.ndarray  # float (n,)
 
-    @property
-    def live(self) -> int:
-        """How many slots hold a cluster."""
-        return int(self.valid.sum())
+    live: int  # how many slots hold a cluster (the first ``live`` ones)
 
     def action_mask(self) -> np.ndarray:
         """int8 mask of the actions worth taking: the live slots, or slot 0 (idle) if none."""
         mask = self.valid.astype(np.int8)
-        if not mask.any():
+        if not self.live:
             mask[0] = 1
         return mask
 
@@ -56,15 +55,21 @@ def build_slots(
     sort_by_distance: bool,
 ) -> SlotTable:
     """Select and order the slots of one robot at ``position`` (row, col)."""
-    live = np.flatnonzero(has_target)
+    if kernels.ENABLED:
+        arrays = kernels.slot_arrays(
+            float(position[0]),
+            float(position[1]),
+            centroids,
+            sizes,
+            gains,
+            has_target,
+            targets,
+            n_slots,
+            sort_by_distance,
+        )
+        return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
+    live, distance = _select_numpy(position, centroids, has_target, n_slots, sort_by_distance)
     centroid_live = centroids[live]
-    distance = np.hypot(centroid_live[:, 0] - position[0], centroid_live[:, 1] - position[1])
-    if len(live) > n_slots:
-        keep = np.sort(np.argsort(distance, kind="stable")[:n_slots])
-        live, distance, centroid_live = live[keep], distance[keep], centroid_live[keep]
-    if sort_by_distance and len(live) > 1:
-        order = np.argsort(distance, kind="stable")
-        live, distance, centroid_live = live[order], distance[order], centroid_live[order]
     k = len(live)
     pad = n_slots - k
     valid = np.zeros(n_slots, dtype=bool)
@@ -77,4 +82,24 @@ def build_slots(
         distance=np.concatenate([distance, np.zeros(pad)]),
         size=np.concatenate([sizes[live], np.zeros(pad, dtype=np.int64)]),
         gain=np.concatenate([gains[live], np.zeros(pad)]),
+        live=k,
     )
+
+
+def _select_numpy(
+    position: np.ndarray,
+    centroids: np.ndarray,
+    has_target: np.ndarray,
+    n_slots: int,
+    sort_by_distance: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(cluster indices, distances) of the slots (the reference of ``kernels.slot_arrays``)."""
+    live = np.flatnonzero(has_target)
+    distance = np.hypot(centroids[live, 0] - position[0], centroids[live, 1] - position[1])
+    if len(live) > n_slots:
+        keep = np.sort(np.argsort(distance, kind="stable")[:n_slots])
+        live, distance = live[keep], distance[keep]
+    if sort_by_distance and len(live) > 1:
+        order = np.argsort(distance, kind="stable")
+        live, distance = live[order], distance[order]
+    return live, distance

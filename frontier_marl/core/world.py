@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from frontier_marl.core import kernels
 from frontier_marl.core.frontiers import (
     Clusters,
     cluster_frontiers,
@@ -60,7 +61,15 @@ class MoveResult:
 class World:
     """Mutable state of one episode. Read it through the read-only array properties."""
 
-    def __init__(self, true_grid: np.ndarray, starts: np.ndarray, params: WorldParams) -> None:
+    def __init__(
+        self,
+        true_grid: np.ndarray,
+        starts: np.ndarray,
+        params: WorldParams,
+        start_region: np.ndarray | None = None,
+    ) -> None:
+        """``start_region``: the free cells reachable from ``starts`` on ``true_grid``, if the
+        caller already has them (computed here otherwise)."""
         true_grid = np.asarray(true_grid, dtype=bool)
         starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
         if true_grid[starts[:, 0], starts[:, 1]].any():
@@ -78,10 +87,17 @@ class World:
         self._plans: list[tuple[tuple[int, int], np.ndarray, int] | None] = [None] * len(starts)
         self._version = 0
         self._cache_version = -1
-        self._cache: tuple[Clusters, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._cache: tuple[Clusters, np.ndarray] | None = None
+        self._components_version = -1
+        self._components = np.zeros(true_grid.shape, dtype=np.int32)
+        self._cell_component = np.zeros(0, dtype=np.int32)
         self._passable_version = -1
         self._passable = np.zeros_like(true_grid)
-        self._start_region = _reachable_region(true_grid, starts)
+        if start_region is None:
+            start_region = _reachable_region(true_grid, starts)
+        elif not start_region[starts[:, 0], starts[:, 1]].all():
+            raise ValueError("start_region must contain every start cell")
+        self._start_region = start_region
         self._start_region_size = int(np.count_nonzero(self._start_region))
         self._true_free_count = int(np.count_nonzero(~true_grid))
         self._fractions: dict[str, float] = {}
@@ -144,7 +160,10 @@ class World:
         if basis == "free":
             return float(np.count_nonzero(belief == FREE)) / max(self._true_free_count, 1)
         if basis == "reachable":
-            known = np.count_nonzero(belief[self._start_region] != UNKNOWN)
+            if kernels.ENABLED:
+                known = kernels.count_known(belief, self._start_region)
+            else:
+                known = np.count_nonzero(belief[self._start_region] != UNKNOWN)
             return float(known) / max(self._start_region_size, 1)
         raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
 
@@ -158,14 +177,23 @@ class World:
 
     def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""
-        clusters, gains, components, cell_component = self._frontier_cache()
-        row, col = self._positions[agent]
-        component = int(components[row, col])
-        found = self._targets.get(component)
-        if found is None:
-            found = nearest_cells_to_centroids(clusters, cell_component == component)
-            self._targets[component] = found
-        has_target, targets = found
+        clusters, gains = self._frontier_cache()
+        if kernels.ENABLED:  # one compiled call: flood fill, targets, selection, padding
+            arrays = kernels.robot_slots(
+                self._belief,
+                int(self._positions[agent, 0]),
+                int(self._positions[agent, 1]),
+                clusters.cell_rows,
+                clusters.cell_cols,
+                clusters.cell_cluster,
+                clusters.centroids,
+                clusters.sizes,
+                gains,
+                n_slots,
+                sort_by_distance,
+            )
+            return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
+        has_target, targets = self._targets_of(agent, clusters)
         return build_slots(
             self._positions[agent],
             clusters.centroids,
@@ -177,7 +205,23 @@ class World:
             sort_by_distance,
         )
 
-    def _frontier_cache(self) -> tuple[Clusters, np.ndarray, np.ndarray, np.ndarray]:
+    def _targets_of(self, agent: int, clusters: Clusters) -> tuple[np.ndarray, np.ndarray]:
+        """Per cluster: reachable from robot ``agent``? and its navigation target."""
+        row, col = int(self._positions[agent, 0]), int(self._positions[agent, 1])
+        # Robots in one known-free component share their targets.
+        if self._components_version != self._version:
+            self._components = free_components(self._belief)
+            self._cell_component = self._components[clusters.cell_rows, clusters.cell_cols]
+            self._targets = {}
+            self._components_version = self._version
+        component = int(self._components[row, col])
+        found = self._targets.get(component)
+        if found is None:
+            found = nearest_cells_to_centroids(clusters, self._cell_component == component)
+            self._targets[component] = found
+        return found
+
+    def _frontier_cache(self) -> tuple[Clusters, np.ndarray]:
         if self._cache_version != self._version or self._cache is None:
             p = self.params
             clusters = cluster_frontiers(self._belief, p.connectivity, p.max_cluster_cells)
@@ -185,10 +229,7 @@ class World:
                 gains = unknown_around(self._belief, clusters).astype(float)
             else:
                 gains = clusters.sizes.astype(float)
-            components = free_components(self._belief)
-            cell_component = components[clusters.cell_rows, clusters.cell_cols]
-            self._cache = (clusters, gains, components, cell_component)
-            self._targets = {}
+            self._cache = (clusters, gains)
             self._cache_version = self._version
         return self._cache
 
@@ -201,10 +242,14 @@ class World:
             path = cached[1]
             if len(path) and (int(path[0, 0]), int(path[0, 1])) == position:
                 return path
-        if self._passable_version != self._version:
-            np.equal(self._belief, FREE, out=self._passable)
-            self._passable_version = self._version
-        path = astar(self._passable, position, target)
+        if kernels.ENABLED:  # plans on the belief directly
+            found = kernels.astar_path(self._belief, FREE, *position, *target)
+            path = found if len(found) else None
+        else:
+            if self._passable_version != self._version:
+                np.equal(self._belief, FREE, out=self._passable)
+                self._passable_version = self._version
+            path = astar(self._passable, position, target)
         self._plans[agent] = None if path is None else (target, path, self._version)
         return path
 
@@ -217,25 +262,26 @@ class World:
         n = self.n_agents
         if len(targets) != n:
             raise ValueError(f"expected {n} targets, got {len(targets)}")
-        remaining: list[np.ndarray] = []
+        budget = self.params.cells_per_step
+        stop = None if budget == FULL_PATH else budget + 1
+        remaining: list[list[list[int]]] = []  # the cells this step may enter, per robot
+        path_lengths: list[int] = []  # moves left to the target, per robot
         for agent, target in enumerate(targets):
             path = None if target is None else self.plan(agent, target)
-            remaining.append(path[1:] if path is not None else np.zeros((0, 2), np.int64))
-        walked: list[list[tuple[int, int]]] = [[(int(r), int(c))] for r, c in self._positions]
-        new_cells = np.zeros(n, dtype=np.int64)
-        budget = self.params.cells_per_step
+            remaining.append([] if path is None else path[1:stop].tolist())
+            path_lengths.append(0 if path is None else len(path) - 1)
+        walked: list[list[tuple[int, int]]] = [[tuple(cell)] for cell in self._positions.tolist()]
+        new_cells = [0] * n
         progress = [0] * n
-        occupied = {cell[0] for cell in walked}
+        occupied = {cells[0] for cells in walked}
         sub_step = 0
         while budget == FULL_PATH or sub_step < budget:
             moved = False
             for agent in range(n):
                 if progress[agent] >= len(remaining[agent]):
                     continue
-                nxt = (
-                    int(remaining[agent][progress[agent], 0]),
-                    int(remaining[agent][progress[agent], 1]),
-                )
+                row, col = remaining[agent][progress[agent]]
+                nxt = (row, col)
                 if nxt in occupied:
                     continue
                 occupied.discard(walked[agent][-1])
@@ -243,8 +289,7 @@ class World:
                 self._positions[agent] = nxt
                 walked[agent].append(nxt)
                 progress[agent] += 1
-                self._travelled[agent] += 1
-                new_cells[agent] += self._sense(agent)
+                new_cells[agent] += self._sense(agent, nxt)
                 moved = True
             sub_step += 1
             if not moved:
@@ -253,17 +298,16 @@ class World:
             plan = self._plans[agent]
             if plan is not None and progress[agent]:
                 self._plans[agent] = (plan[0], plan[1][progress[agent] :], plan[2])
-        reached = np.array(
-            [len(remaining[a]) > 0 and progress[a] == len(remaining[a]) for a in range(n)]
-        )
-        paths = [np.array(w, dtype=np.int64) for w in walked]
-        return MoveResult(new_cells, paths, reached)
+            self._travelled[agent] += progress[agent]
+        reached = np.array([0 < path_lengths[a] == progress[a] for a in range(n)])
+        paths = [np.array(cells, dtype=np.int64) for cells in walked]
+        return MoveResult(np.array(new_cells, dtype=np.int64), paths, reached)
 
-    def _sense(self, agent: int) -> int:
-        row, col = self._positions[agent]
-        count = self.params.sensor.sense(
-            self._true, self._belief, (int(row), int(col)), self._seen[agent]
-        )
+    def _sense(self, agent: int, cell: tuple[int, int] | None = None) -> int:
+        """Sense from robot ``agent``'s cell (given as ``cell`` when known); count new cells."""
+        if cell is None:
+            cell = (int(self._positions[agent, 0]), int(self._positions[agent, 1]))
+        count = self.params.sensor.sense(self._true, self._belief, cell, self._seen[agent])
         if count:
             self._version += 1
         return count
