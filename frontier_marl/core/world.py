@@ -17,6 +17,7 @@ Multi-robot rules (documented in docs/environment.md):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -103,8 +104,25 @@ class World:
         self._fractions: dict[str, float] = {}
         self._fraction_version = -1
         self._targets: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._make_views()
         for agent in range(len(starts)):
             self._sense(agent)
+
+    def _make_views(self) -> None:
+        # Read-only views, made once: the arrays behind them are only ever changed in place.
+        self._views = {
+            name: _read_only(getattr(self, f"_{name}"))
+            for name in ("belief", "positions", "seen", "travelled", "start_region")
+        }
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        del state["_views"]  # a pickled view would become a copy, detached from its array
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._make_views()
 
     # ----------------------------------------------------------------- read-only state
     @property
@@ -113,26 +131,26 @@ class World:
 
     @property
     def belief(self) -> np.ndarray:
-        return _read_only(self._belief)
+        return self._views["belief"]
 
     @property
     def positions(self) -> np.ndarray:
-        return _read_only(self._positions)
+        return self._views["positions"]
 
     @property
     def seen(self) -> np.ndarray:
         """(N, H, W) bool: cells each robot has perceived at least once."""
-        return _read_only(self._seen)
+        return self._views["seen"]
 
     @property
     def travelled(self) -> np.ndarray:
         """Cells moved by each robot since the start."""
-        return _read_only(self._travelled)
+        return self._views["travelled"]
 
     @property
     def start_region(self) -> np.ndarray:
         """Free cells reachable from the start cells on the true grid."""
-        return _read_only(self._start_region)
+        return self._views["start_region"]
 
     @property
     def n_agents(self) -> int:
