@@ -211,7 +211,7 @@ class World:
                 sort_by_distance,
             )
             return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
-        has_target, targets = self._targets_of(agent, clusters)
+        has_target, targets = self._targets_by_component(agent, clusters)
         return build_slots(
             self._positions[agent],
             clusters.centroids,
@@ -223,8 +223,10 @@ class World:
             sort_by_distance,
         )
 
-    def _targets_of(self, agent: int, clusters: Clusters) -> tuple[np.ndarray, np.ndarray]:
-        """Per cluster: reachable from robot ``agent``? and its navigation target."""
+    def _targets_by_component(
+        self, agent: int, clusters: Clusters
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Without kernels: per cluster, whether robot ``agent`` reaches it, and its target."""
         row, col = int(self._positions[agent, 0]), int(self._positions[agent, 1])
         # Robots in one known-free component share their targets.
         if self._components_version != self._version:

@@ -51,7 +51,7 @@ class FrontierParallelEnv(ParallelEnv):
     ``new_cells``, ``action_mask``, ``clusters`` (slot, cluster, centroid, target, size, gain,
     distance for each live slot), ``path`` (cells occupied this step, start included),
     ``target``, ``position``, ``travelled``, ``padding``, ``oscillation``, ``step``,
-    ``end_reason``.
+    ``end_reason``; a ``StepInfo`` dict whose deep copy is shallow (treat it as read-only).
 
     **Version history.** v0: first release.
     """
