@@ -23,6 +23,8 @@ gain and distance per live slot; ``action_mask``; ``position``), never hidden en
   the robots have built, i.e. what they know, not hidden state). :func:`frontier_marl.
   evaluation.evaluate` attaches the env automatically.
 * ``random``: uniform over the valid slots of ``action_mask``, from its own seeded generator.
+* ``first-slot``: always slot 0, the thesis's degenerate policy as a baseline (greedy distance
+  when slots are sorted; the top-most of the selected clusters when unsorted).
 
 Two *joint* heuristics decide for the whole team at once (:meth:`Policy.act_team`). They read
 each robot's ``clusters`` and ``position`` and the shared belief (from ``info["belief"]`` or the
@@ -144,6 +146,19 @@ class GreedyGain(HeuristicPolicy):
             clusters, key=lambda c: (-float(c["gain"]), float(c["distance"]), int(c["slot"]))
         )
         return int(best["slot"])
+
+
+class FirstSlot(HeuristicPolicy):
+    """Always slot 0, the thesis's degenerate "reward hacking" policy as a baseline.
+
+    With distance-sorted slots this is greedy distance; unsorted (the default), slot 0 is the
+    first of the selected clusters in raster order, i.e. the top-most of the nearest ones.
+    """
+
+    name = "first-slot"
+
+    def choose(self, info: Info) -> int:
+        return 0
 
 
 class CostUtility(HeuristicPolicy):
@@ -499,6 +514,7 @@ POLICIES: dict[str, type[Policy]] = {
     "greedy-gain": GreedyGain,
     "cost-utility": CostUtility,
     "random": RandomValid,
+    "first-slot": FirstSlot,
     "coordinated-assignment": CoordinatedAssignment,
     "utility-discount": UtilityDiscount,
 }

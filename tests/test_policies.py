@@ -12,6 +12,7 @@ from frontier_marl.policies import (
     POLICIES,
     CallablePolicy,
     CostUtility,
+    FirstSlot,
     GreedyDistance,
     GreedyGain,
     ModelPolicy,
@@ -42,6 +43,19 @@ def info_with(clusters: list[dict], n_slots: int = 4, position=(0, 0), **extra) 
 
 
 # ----------------------------------------------------------------- greedy distance / gain
+
+
+def test_first_slot_is_greedy_distance_when_slots_are_sorted():
+    from frontier_marl.evaluation import evaluate
+
+    env = {"preset": "thesis-20x20", "sort_by_distance": True}
+    first = evaluate(env, FirstSlot(), episodes=3)
+    greedy = evaluate(env, GreedyDistance(), episodes=3)
+    assert first.rewards == greedy.rewards
+    unsorted = evaluate({"preset": "thesis-20x20"}, FirstSlot(), episodes=3)
+    assert unsorted.rewards != first.rewards  # slot 0 is another cluster when unsorted
+    info = info_with([cluster(2, 9, 0.5), cluster(0, 1, 4.0)])
+    assert FirstSlot().act(None, info) == 0
 
 
 def test_greedy_distance_picks_the_nearest_centroid():
