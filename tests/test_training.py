@@ -121,11 +121,11 @@ def test_end_of_episode_keys_survive_the_vector_wrappers() -> None:
     assert "terminal_observation" in infos[0]
 
 
-def _collect(env_kwargs: dict, steps: int) -> object:
+def _collect(env_kwargs: dict, steps: int, bootstrap_truncations: bool = True) -> object:
     """A DQN that only collects ``steps`` transitions (no gradient step)."""
     from stable_baselines3 import DQN
 
-    vec = make_vec_env(env_kwargs, seed=0)
+    vec = make_vec_env(env_kwargs, seed=0, bootstrap_truncations=bootstrap_truncations)
     model = DQN("MultiInputPolicy", vec, learning_starts=10**9, buffer_size=1000, device="cpu")
     model.learn(steps)
     return model
@@ -141,6 +141,17 @@ def test_truncated_transitions_are_bootstrapped_in_the_replay_buffer() -> None:
     batch = buffer._get_samples(np.arange(n))
     # the TD target's done flag is 0 for a truncation: the next value is bootstrapped
     assert float(batch.dones.sum()) == 0.0
+
+
+def test_truncations_are_terminal_when_bootstrapping_is_off() -> None:
+    model = _collect({**SMALL, "max_steps": 3, "explore_threshold": 1.0}, 60, False)
+    buffer = model.replay_buffer
+    n = buffer.size()
+    dones = buffer.dones[:n, 0]
+    assert dones.sum() >= 15
+    assert buffer.timeouts[:n, 0].sum() == 0  # SuperSuit's own behaviour: no timeout marks
+    batch = buffer._get_samples(np.arange(n))
+    assert float(batch.dones.sum()) == dones.sum()  # the TD target stops at every truncation
 
 
 def test_terminated_transitions_are_not_bootstrapped() -> None:
@@ -223,6 +234,7 @@ def test_config_by_name_and_overrides() -> None:
         ("dqn.learning_rat=1e-4", "learning_rat"),
         ("dqn.seed=3", "seed"),
         ("train.n_envs=0", "n_envs"),
+        ("train.bootstrap_truncations=1", "bootstrap_truncations"),
         ("dqn.train_freq=-1", "train_freq"),
         ("exploration_fraction=1.5", "exploration_fraction"),
         ("dqn.learning_rate=0", "learning_rate"),

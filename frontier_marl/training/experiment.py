@@ -74,6 +74,9 @@ class TrainSettings:
         eval_seed: first seed of the evaluation episodes.
         torch_threads: ``torch.set_num_threads`` value (1 is fastest for this small MLP).
         device: torch device of the model.
+        bootstrap_truncations: pass truncations to SB3 as truncations (``TimeLimit.truncated``,
+            the TD target bootstraps there). False treats them as terminal, as SuperSuit does
+            by itself (an experiment option; see docs/results.md).
     """
 
     total_timesteps: int = 1_000_000
@@ -86,6 +89,7 @@ class TrainSettings:
     eval_seed: int = 0
     torch_threads: int = 1
     device: str = "cpu"
+    bootstrap_truncations: bool = True
 
     def __post_init__(self) -> None:
         for name, low in (
@@ -102,6 +106,11 @@ class TrainSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if not isinstance(self.bootstrap_truncations, bool):
+            raise ValueError(
+                "train.bootstrap_truncations must be true or false, "
+                f"got {self.bootstrap_truncations!r}"
+            )
         if not isinstance(self.device, str) or not self.device:
             raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
 

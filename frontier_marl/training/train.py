@@ -145,7 +145,12 @@ def train(
     start_step = 0 if checkpoint is None else checkpoint.step
     seed = session_seed(settings.seed, start_step)
     set_random_seed(seed)
-    vec_env = make_vec_env({"config": cfg}, settings.n_envs, seed=seed)
+    vec_env = make_vec_env(
+        {"config": cfg},
+        settings.n_envs,
+        seed=seed,
+        bootstrap_truncations=settings.bootstrap_truncations,
+    )
     if checkpoint is None:
         try:
             model = DQN(

@@ -43,35 +43,50 @@ class TimeLimitInfo(BaseParallelWrapper):
       ...). SuperSuit's ``MarkovVectorEnv`` merges the next episode's reset info over the last
       step's info, so the env's own ``end_reason``/``step`` keys read ``""``/``0`` there.
 
+    With ``mark_truncations=False`` the first key is left out, so SB3 treats truncations as
+    terminal: SuperSuit's own behaviour, kept as an option for experiments (the thesis's
+    SuperSuit pipeline most likely ran that way).
+
     The only work on an ordinary step is two ``any()`` over the agents' flags.
     """
+
+    def __init__(self, env: Any, mark_truncations: bool = True) -> None:
+        super().__init__(env)
+        self.mark_truncations = mark_truncations
 
     def step(self, actions: dict[str, Any]) -> tuple[Any, Any, Any, Any, Any]:
         observations, rewards, terminations, truncations, infos = self.env.step(actions)
         if any(truncations.values()) or any(terminations.values()):
             for agent, info in infos.items():
                 info[END_REASON_KEY] = info.get("end_reason", "")
-                if truncations[agent] and not terminations[agent]:
+                if self.mark_truncations and truncations[agent] and not terminations[agent]:
                     info[TRUNCATED_KEY] = True
         return observations, rewards, terminations, truncations, infos
 
 
-def make_parallel_env(env_kwargs: dict[str, Any]) -> TimeLimitInfo:
+def make_parallel_env(env_kwargs: dict[str, Any], mark_truncations: bool = True) -> TimeLimitInfo:
     """The wrapped ParallelEnv for ``env_kwargs`` (flat keywords of ``make_config``)."""
-    return TimeLimitInfo(FrontierParallelEnv(**env_kwargs))
+    return TimeLimitInfo(FrontierParallelEnv(**env_kwargs), mark_truncations)
 
 
-def make_vec_env(env_kwargs: dict[str, Any], n_envs: int = 1, seed: int | None = None) -> Any:
+def make_vec_env(
+    env_kwargs: dict[str, Any],
+    n_envs: int = 1,
+    seed: int | None = None,
+    bootstrap_truncations: bool = True,
+) -> Any:
     """An SB3 ``VecMonitor`` over ``n_envs`` SuperSuit copies of the env (see module doc).
 
-    With ``seed`` the copies are reset once with distinct seeds (:func:`seed_vec_env`).
+    With ``seed`` the copies are reset once with distinct seeds (:func:`seed_vec_env`). With
+    ``bootstrap_truncations=False`` SB3 treats truncations as terminal (see
+    :class:`TimeLimitInfo`).
     """
     import supersuit as ss
     from stable_baselines3.common.vec_env import VecMonitor
 
     if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
         raise ValueError(f"n_envs must be an integer >= 1, got {n_envs!r}")
-    markov = ss.pettingzoo_env_to_vec_env_v1(make_parallel_env(env_kwargs))
+    markov = ss.pettingzoo_env_to_vec_env_v1(make_parallel_env(env_kwargs, bootstrap_truncations))
     vec = ss.concat_vec_envs_v1(markov, n_envs, num_cpus=0, base_class="stable_baselines3")
     with warnings.catch_warnings():
         # SuperSuit's ConcatVecEnv has no get_attr, so SB3 cannot read render_mode (harmless)
