@@ -2,14 +2,15 @@
 
 Each kernel is a loop version of a numpy/scipy reference function elsewhere in the core and
 returns bit-identical results (same tie-breaking, same floating-point operations in the same
-order); ``tests/test_kernels.py`` checks that on random beliefs. The reference functions call
-these kernels when :data:`ENABLED` is true:
+order); ``tests/test_kernels.py`` checks that on random beliefs and whole episodes. The core
+(``frontiers``, ``slots``, ``planning``, ``sensing``, ``world``) calls them instead of its
+reference code when :data:`ENABLED` is true:
 
 * numba is installed (``pip install "frontier-marl[fast]"``; the ``train`` extra includes it), and
 * the environment variable ``FRONTIER_MARL_NO_NUMBA`` is unset or ``0``.
 
-Clustering itself stays ``scipy.ndimage.label`` in both modes. Without numba the kernels below
-are plain Python functions (slow, used only by the tests to check the logic).
+Clustering itself stays ``scipy.ndimage.label`` in both modes. Without numba the functions
+below stay plain Python and the core does not call them.
 """
 
 from __future__ import annotations
@@ -108,7 +109,6 @@ def split_and_renumber(
     pieces = 0
     stack = np.empty((2 * n + 2, 2), dtype=np.int64)  # segments [lo, hi) of ``order``
     for k in range(count):
-        top = 0
         stack[0, 0] = starts[k]
         stack[0, 1] = starts[k + 1]
         top = 1
