@@ -14,7 +14,11 @@ from hypothesis import strategies as st
 
 import frontier_marl
 from frontier_marl.core import kernels
-from frontier_marl.core.frontiers import cluster_frontiers, nearest_cells_to_centroids
+from frontier_marl.core.frontiers import (
+    cluster_frontiers,
+    free_components,
+    nearest_cells_to_centroids,
+)
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.planning import astar
 from frontier_marl.core.sensing import RaycastSensor
@@ -60,7 +64,7 @@ def assert_same(a, b) -> None:
 dims = st.integers(min_value=1, max_value=24)
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=150)
 @given(seed=st.integers(0, 10**6), height=dims, width=dims, max_cells=st.integers(0, 10))
 def test_clusters_match(seed, height, width, max_cells):
     belief = random_belief(seed, height, width)
@@ -70,7 +74,7 @@ def test_clusters_match(seed, height, width, max_cells):
             assert_same(getattr(compiled, field), getattr(reference, field))
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=150)
 @given(seed=st.integers(0, 10**6), height=dims, width=dims, sort=st.booleans())
 def test_targets_and_slots_match(seed, height, width, sort):
     belief = random_belief(seed, height, width)
@@ -87,7 +91,7 @@ def test_targets_and_slots_match(seed, height, width, sort):
         assert_same(getattr(compiled, field), getattr(reference, field))
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200)
 @given(seed=st.integers(0, 10**6), height=dims, width=dims)
 def test_astar_matches(seed, height, width):
     rng = np.random.default_rng(seed)
@@ -101,8 +105,6 @@ def test_reachable_targets_match_the_component_rule():
     belief = random_belief(3, 15, 17)
     clusters = cluster_frontiers(belief, 8, 4)
     free = np.argwhere(belief == FREE)
-    from frontier_marl.core.frontiers import free_components
-
     components = free_components(belief)
     for row, col in free[:: max(1, len(free) // 10)]:
         reachable = components[clusters.cell_rows, clusters.cell_cols] == components[row, col]
