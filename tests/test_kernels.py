@@ -170,3 +170,11 @@ def test_episodes_identical_with_and_without_kernels(kwargs):
     compiled, reference = both(episodes)
     assert compiled == reference
     assert len(compiled) > 20
+
+
+def test_compiles_without_a_writable_cache():
+    namespace: dict = {}
+    exec("def add_one(x):\n    return x + 1\n", namespace)  # no source file: numba cannot cache
+    compiled = kernels._compile(namespace["add_one"])
+    assert compiled(41) == 42
+    assert compiled is not namespace["add_one"]  # compiled, not the plain function

@@ -40,10 +40,14 @@ ENABLED: bool = NUMBA_AVAILABLE and os.environ.get("FRONTIER_MARL_NO_NUMBA", "0"
 
 
 def _compile(function: F) -> F:
-    """``numba.njit`` with an on-disk cache, or the plain function without numba."""
+    """``numba.njit`` with an on-disk cache (without one if no cache folder is writable), or
+    the plain function without numba."""
     if numba is None:
         return function
-    return numba.njit(cache=True, nogil=True)(function)  # type: ignore[no-any-return]
+    try:
+        return numba.njit(cache=True, nogil=True)(function)  # type: ignore[no-any-return]
+    except RuntimeError:  # numba found no writable cache location: compile in every process
+        return numba.njit(nogil=True)(function)  # type: ignore[no-any-return]
 
 
 @_compile
