@@ -392,15 +392,32 @@ def count_known(belief: np.ndarray, region: np.ndarray) -> int:
 
 
 @_compile
-def reveal(
-    true_grid: np.ndarray, belief: np.ndarray, seen: np.ndarray, rows: np.ndarray, cols: np.ndarray
+def raycast_reveal(
+    true_grid: np.ndarray,
+    belief: np.ndarray,
+    seen: np.ndarray,
+    row: int,
+    col: int,
+    offsets: np.ndarray,
+    between: np.ndarray,
 ) -> int:
-    """Write the true state of cells (rows, cols) into ``belief``, mark them in ``seen``;
-    return how many were unknown."""
+    """Sense from (row, col) as ``sensing.RaycastSensor`` does: every offset inside the grid
+    whose in-between cells (``between``, padded with the origin) are all free is marked in
+    ``seen`` and written into ``belief``; returns how many of them were unknown."""
+    height, width = true_grid.shape
     count = 0
-    for i in range(len(rows)):
-        r = rows[i]
-        c = cols[i]
+    for i in range(len(offsets)):
+        r = row + offsets[i, 0]
+        c = col + offsets[i, 1]
+        if not (0 <= r < height and 0 <= c < width):
+            continue
+        blocked = False
+        for k in range(between.shape[1]):
+            if true_grid[row + between[i, k, 0], col + between[i, k, 1]]:
+                blocked = True
+                break
+        if blocked:
+            continue
         seen[r, c] = True
         if belief[r, c] == UNKNOWN:
             belief[r, c] = OCCUPIED if true_grid[r, c] else FREE

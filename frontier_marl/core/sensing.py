@@ -118,9 +118,19 @@ class RaycastSensor:
         cell: tuple[int, int],
         seen: np.ndarray | None = None,
     ) -> int:
+        if kernels.ENABLED and seen is not None:  # casts the rays itself, no cache needed
+            return int(
+                kernels.raycast_reveal(
+                    true_grid,
+                    belief,
+                    seen,
+                    int(cell[0]),
+                    int(cell[1]),
+                    self._offsets,
+                    self._between,
+                )
+            )
         rows, cols = self.visible_cells(true_grid, cell)
-        if kernels.ENABLED and seen is not None:
-            return int(kernels.reveal(true_grid, belief, seen, rows, cols))
         if seen is not None:
             seen[rows, cols] = True
         unknown = belief[rows, cols] == UNKNOWN
