@@ -2,12 +2,15 @@
 
     python benchmarks/bench_training.py                       # config01, 20 000 steps
     python benchmarks/bench_training.py config04 --steps 50000 --json speed.json
+    python benchmarks/bench_training.py --stages   # also time the stages inside the env step
 
 Runs the real training loop (``frontier_marl.training.train.train``, no evaluation, no
 checkpoints) and times, inside it, the env (the FrontierParallelEnv step itself), the SuperSuit
 and SB3 vector layers above it, and the DQN gradient steps; the rest is SB3's collection loop
-(action selection, replay buffer, logging). Wall and CPU times are both reported: on a shared
-machine the CPU time is the steadier number. Run one benchmark at a time.
+(action selection, replay buffer, logging). ``--stages`` also times the parts of a decision
+step (movement and sensing, frontier clustering and ``scipy.ndimage.label``, slots,
+observation, reward table, info) and the episode resets. Wall and CPU times are both
+reported: on a shared machine the CPU time is the steadier number. Run one benchmark at a time.
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from scipy import ndimage
+
 from frontier_marl.training.experiment import load_experiment
 from frontier_marl.training.train import train
 
@@ -29,6 +34,7 @@ class Timer:
     def __init__(self) -> None:
         self.seconds = 0.0
         self.calls = 0
+        self.first_call_seconds = 0.0  # the first reset of a process loads the compiled kernels
 
     def wrap(self, fn):  # noqa: ANN001, ANN202
         def timed(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
@@ -36,10 +42,29 @@ class Timer:
             try:
                 return fn(*args, **kwargs)
             finally:
-                self.seconds += time.perf_counter() - start
+                elapsed = time.perf_counter() - start
+                if not self.calls:
+                    self.first_call_seconds = elapsed
+                self.seconds += elapsed
                 self.calls += 1
 
         return timed
+
+
+def stage_functions() -> list[tuple[object, str]]:
+    """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
+    from frontier_marl import engine
+    from frontier_marl.core import world
+
+    return [
+        (world.World, "move"),  # planning, walking, sensing
+        (engine.ExplorationMDP, "_refresh_slots"),  # clusters (with ndimage.label) and slots
+        (ndimage, "label"),
+        (engine.ExplorationMDP, "_observations"),
+        (engine, "step_outcome"),  # the reward table
+        (engine.ExplorationMDP, "_infos"),
+        (engine.ExplorationMDP, "reset"),
+    ]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -49,6 +74,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--set", dest="overrides", action="append", default=[])
     parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--stages", action="store_true", help="time the stages of a step too")
     args = parser.parse_args(argv)
 
     import stable_baselines3
@@ -78,11 +104,21 @@ def main(argv: list[str] | None = None) -> int:
         return vec
 
     vec_module.make_vec_env = make_timed_vec_env
+    stage_timers: dict[str, Timer] = {}
+    patched: list[tuple[object, str, object]] = []
+    if args.stages:
+        for owner, name in stage_functions():
+            timer = stage_timers[name if owner is not ndimage else "ndimage.label"] = Timer()
+            original = getattr(owner, name)
+            patched.append((owner, name, original))
+            setattr(owner, name, timer.wrap(original))
     try:
         with tempfile.TemporaryDirectory() as tmp:
             result = train(experiment, Path(tmp) / "run", progress_bar=False)
     finally:
         FrontierParallelEnv.step, DQN.train, vec_module.make_vec_env = originals
+        for owner, name, original in patched:
+            setattr(owner, name, original)
 
     wall, cpu, steps = result.wall_time_s, result.cpu_time_s, result.steps_this_session
     report = {
@@ -103,8 +139,25 @@ def main(argv: list[str] | None = None) -> int:
         "stable_baselines3": stable_baselines3.__version__,
         "python": sys.version.split()[0],
     }
+    report["stages"] = {  # without each stage's first call (one-time costs, kernel loading)
+        name: {
+            "calls": timer.calls - 1,
+            "us_per_call": round(later / max(timer.calls - 1, 1) * 1e6, 1),
+            "us_per_env_step": round(later / max(env_timer.calls, 1) * 1e6, 1),
+            "first_call_ms": round(timer.first_call_seconds * 1e3, 1),
+        }
+        for name, timer in stage_timers.items()
+        for later in [timer.seconds - timer.first_call_seconds]
+    }
     for key, value in report.items():
-        print(f"{key:>28}: {value}")
+        if key != "stages":
+            print(f"{key:>28}: {value}")
+    for name, row in report["stages"].items():
+        print(
+            f"{name:>28}: {row['us_per_env_step']:6.1f} µs per env step "
+            f"({row['calls']} calls, {row['us_per_call']} µs each; "
+            f"first call {row['first_call_ms']} ms, not counted)"
+        )
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2) + "\n")
     return 0

@@ -1,0 +1,45 @@
+"""benchmarks/bench_training.py with a tiny budget: the report and its stage timings."""
+
+from __future__ import annotations
+
+import json
+import runpy
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_stage_report_is_consistent(tmp_path: Path) -> None:
+    main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
+    out = tmp_path / "speed.json"
+    assert main(["config01", "--steps", "600", "--stages", "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert report["steps"] == 600
+    shares = [report[k] for k in report if k.startswith("share_")]
+    assert abs(sum(shares) - 1.0) < 0.01  # env + vector layers + gradient steps + rest
+    stages = report["stages"]
+    assert set(stages) == {
+        "move",
+        "_refresh_slots",
+        "ndimage.label",
+        "_observations",
+        "step_outcome",
+        "_infos",
+        "reset",
+    }
+    assert stages["move"]["calls"] == 600 - 1  # one per env step, the first left out
+    assert stages["reset"]["calls"] >= 1
+    # The stages run inside the env step, so together they take less time than it does.
+    inside_step = sum(stages[k]["us_per_env_step"] for k in stages if k not in ("reset",))
+    inside_step -= stages["ndimage.label"]["us_per_env_step"]  # part of _refresh_slots
+    assert 0 < inside_step < report["us_per_env_step"] + 1.0
+
+
+def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
+    from frontier_marl import engine
+    from frontier_marl.core import world
+
+    before = (world.World.move, engine.step_outcome, engine.ExplorationMDP.reset)
+    main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
+    main(["config01", "--steps", "200", "--stages"])
+    assert (world.World.move, engine.step_outcome, engine.ExplorationMDP.reset) == before
