@@ -306,6 +306,7 @@ def _figures(
     from frontier_marl.plots import plot_baselines
     from frontier_marl.training.callbacks import read_metrics
     from frontier_marl.training.plots import plot_action_comparison, plot_learning_curve
+    from frontier_marl.training.validation import read_validation_log
 
     dqn = table["rows"][0]
     setting = table["setting"]
@@ -347,5 +348,6 @@ def _figures(
         files["learning_curve"],
         title=f"{name} (seed {table['training']['seed']}, {trained.num_timesteps} steps)",
         reference=reference,
+        validation=read_validation_log(trained.run_dir),
     )
     return files

@@ -169,6 +169,13 @@ def run(args: argparse.Namespace) -> int:
         return 130
     if result.evaluation is not None:
         print(format_comparison(result.evaluation))
+    if result.best_evaluation is not None:
+        chosen = result.best_evaluation.get("validation") or {}
+        print(
+            f"best validated policy (step {chosen.get('step')}, validation mean "
+            f"{chosen.get('mean_reward', float('nan')):.2f}), same protocol:"
+        )
+        print(format_comparison(result.best_evaluation))
     for label, path in result.files.items():
         print(f"  {label}: {path}")
     return 0

@@ -34,6 +34,29 @@ class PeriodicCheckpoint(BaseCallback):
         return True
 
 
+class PeriodicValidation(BaseCallback):
+    """Every ``every`` environment steps (counted from step 0), calls ``validate(model)``, which
+    scores the greedy policy on held-out episodes, and logs the score as
+    ``eval/validation_mean_reward``."""
+
+    def __init__(self, every: int, validate: Callable[[Any], float]) -> None:
+        super().__init__()
+        if every < 1:
+            raise ValueError(f"validation interval must be >= 1, got {every}")
+        self.every = every
+        self.validate = validate
+        self._next = every
+
+    def _on_training_start(self) -> None:
+        self._next = (self.model.num_timesteps // self.every + 1) * self.every
+
+    def _on_step(self) -> bool:
+        if self.model.num_timesteps >= self._next:
+            self.logger.record("eval/validation_mean_reward", self.validate(self.model))
+            self._next = (self.model.num_timesteps // self.every + 1) * self.every
+        return True
+
+
 class ProgressBar(BaseCallback):
     """A tqdm progress bar over the session's steps, with the rolling episode reward and
     epsilon. Unlike SB3's ``ProgressBarCallback`` (a rich bar redrawn from every step, which

@@ -77,6 +77,13 @@ class TrainSettings:
         bootstrap_truncations: pass truncations to SB3 as truncations (``TimeLimit.truncated``,
             the TD target bootstraps there). False treats them as terminal, as SuperSuit does
             by itself (an experiment option; see docs/results.md).
+        validate_every: steps between validations of the greedy policy on held-out episodes
+            (0: none). The best-scoring policy is kept in ``RUN/best/`` and evaluated with
+            the thesis protocol at the end, beside the final one (SB3's ``EvalCallback``
+            practice).
+        validation_episodes: episodes per validation.
+        validation_seed: first reset seed of the validation episodes; the range must not
+            overlap the evaluation's (``eval_seed`` .. ``eval_seed + eval_episodes - 1``).
     """
 
     total_timesteps: int = 1_000_000
@@ -90,6 +97,9 @@ class TrainSettings:
     torch_threads: int = 1
     device: str = "cpu"
     bootstrap_truncations: bool = True
+    validate_every: int = 0
+    validation_episodes: int = 30
+    validation_seed: int = 1000
 
     def __post_init__(self) -> None:
         for name, low in (
@@ -102,6 +112,9 @@ class TrainSettings:
             ("eval_episodes", 0),
             ("eval_seed", 0),
             ("torch_threads", 1),
+            ("validate_every", 0),
+            ("validation_episodes", 1),
+            ("validation_seed", 0),
         ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
@@ -111,6 +124,17 @@ class TrainSettings:
                 "train.bootstrap_truncations must be true or false, "
                 f"got {self.bootstrap_truncations!r}"
             )
+        if self.validate_every and self.eval_episodes:
+            first = self.validation_seed
+            validation = range(first, first + self.validation_episodes)
+            evaluation = range(self.eval_seed, self.eval_seed + self.eval_episodes)
+            if validation.start < evaluation.stop and evaluation.start < validation.stop:
+                raise ValueError(
+                    f"train.validation_seed: validation episodes (seeds {validation.start}.."
+                    f"{validation.stop - 1}) overlap the evaluation episodes (seeds "
+                    f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
+                    "on the evaluation episodes would bias the evaluation"
+                )
         if not isinstance(self.device, str) or not self.device:
             raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
 

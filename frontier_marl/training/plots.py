@@ -74,18 +74,25 @@ def plot_learning_curve(
     path: str | os.PathLike[str],
     title: str | None = None,
     reference: Mapping[str, float] | None = None,
+    validation: Sequence[Mapping[str, Any]] = (),
 ) -> None:
     """Three panels against training steps: mean episode reward (SB3's rolling
     ``rollout/ep_rew_mean``), TD loss (``train/loss``, log scale) and epsilon
-    (``rollout/exploration_rate``). ``reference`` maps labels to horizontal reward lines."""
+    (``rollout/exploration_rate``). ``reference`` maps labels to horizontal reward lines;
+    ``validation`` records (``step``, ``mean_reward``) add the greedy policy's scores."""
     plt = _pyplot()
     fig, (reward, loss, eps) = plt.subplots(1, 3, figsize=(13, 3.6))
     try:
         steps, values = _series(metrics, "rollout/ep_rew_mean")
-        reward.plot(steps, values, color="C0")
+        reward.plot(steps, values, color="C0", label="training episodes (epsilon-greedy)")
+        steps, values = _series(validation, "mean_reward")
+        if len(steps):
+            reward.plot(
+                steps, values, color="C4", marker=".", linewidth=0.8, label="greedy, validation"
+            )
         for i, (label, value) in enumerate((reference or {}).items()):
             reward.axhline(value, color=f"C{i + 1}", linestyle=":", linewidth=1, label=label)
-        if reference:
+        if reference or len(steps):
             reward.legend(fontsize=8, loc="lower right")
         reward.set_title("episode reward (rolling mean of 100)", fontsize=9)
         steps, values = _series(metrics, "train/loss")

@@ -10,6 +10,8 @@ Run folder::
     RUN/tb/                          TensorBoard: rollout/ep_rew_mean, train/loss,
                                      rollout/exploration_rate
     RUN/checkpoints/step_*/          model + replay buffer + metadata (newest ``keep`` kept)
+    RUN/validation.jsonl, RUN/best/  with ``train.validate_every``: validation scores, and the
+                                     best-validated policy with its own evaluation.json
     RUN/run.json                     the experiment and one entry per training session
 
 Seeding follows DESIGN's traps: ``DQN(seed=...)`` is never used (SuperSuit's ``ConcatVecEnv``
@@ -30,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.training.checkpoints import (
+    MODEL_FILE,
     Checkpoint,
     find_checkpoint,
     list_checkpoints,
@@ -37,10 +40,12 @@ from frontier_marl.training.checkpoints import (
 )
 from frontier_marl.training.experiment import Experiment, TrainSettings, experiment_from_dict
 from frontier_marl.training.metadata import build_metadata, save_metadata
+from frontier_marl.training.validation import BEST_DIR
 
 #: Train settings a resumed run may change; everything else must match the checkpoint.
 RESUMABLE_TRAIN_KEYS = {
     "total_timesteps",
+    "validate_every",
     "checkpoint_every",
     "keep_checkpoints",
     "log_interval",
@@ -62,6 +67,7 @@ class TrainResult:
     cpu_time_s: float
     interrupted: bool
     evaluation: dict[str, Any] | None = None
+    best_evaluation: dict[str, Any] | None = None  # of RUN/best/ (with train.validate_every)
     files: dict[str, Path] = field(default_factory=dict)
 
     @property
@@ -198,6 +204,12 @@ def train(
         from frontier_marl.training.callbacks import PeriodicCheckpoint
 
         all_callbacks.append(PeriodicCheckpoint(settings.checkpoint_every, checkpoint_now))
+    if settings.validate_every > 0:
+        from frontier_marl.training.callbacks import PeriodicValidation
+        from frontier_marl.training.validation import BestPolicyKeeper
+
+        keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, start_step)
+        all_callbacks.append(PeriodicValidation(settings.validate_every, keeper))
 
     remaining = settings.total_timesteps - model.num_timesteps
     interrupted = False
@@ -256,6 +268,22 @@ def train(
         result.evaluation = _final_evaluation(
             model, model_path, meta, cfg, settings, run_dir, experiment, result
         )
+        best = run_dir / BEST_DIR / MODEL_FILE
+        if settings.validate_every > 0 and best.is_file():
+            from frontier_marl.training.evaluate_model import load_model
+
+            loaded = load_model(best, device=settings.device)
+            result.best_evaluation = _final_evaluation(
+                loaded.model,
+                best,
+                loaded.metadata or {},
+                cfg,
+                settings,
+                run_dir / BEST_DIR,
+                experiment,
+                result,
+                label="best",
+            )
     return result
 
 
@@ -331,12 +359,14 @@ def _record_session(
 def _plot_learning_curve(run_dir: Path, experiment: Experiment, result: TrainResult) -> None:
     from frontier_marl.training.callbacks import read_metrics
     from frontier_marl.training.plots import plot_learning_curve
+    from frontier_marl.training.validation import read_validation_log
 
     path = run_dir / "learning_curve.png"
     plot_learning_curve(
         read_metrics(run_dir / "metrics.jsonl"),
         path,
         title=f"{experiment.name} (seed {experiment.train.seed}, {result.num_timesteps} steps)",
+        validation=read_validation_log(run_dir),
     )
     result.files["learning_curve"] = path
 
@@ -350,28 +380,34 @@ def _final_evaluation(
     run_dir: Path,
     experiment: Experiment,
     result: TrainResult,
+    label: str = "",
 ) -> dict[str, Any]:
+    """The protocol evaluation of a model, saved in ``run_dir`` (the run's or ``RUN/best/``)."""
     from frontier_marl.training.evaluate_model import LoadedModel, evaluate_model
     from frontier_marl.training.plots import plot_action_histogram
 
     loaded = LoadedModel(model=model, path=model_path, metadata=meta)
+    name = f"{experiment.name} ({label})" if label else experiment.name
     evaluation = evaluate_model(
         loaded,
         cfg,
         episodes=settings.eval_episodes,
         seed=settings.eval_seed,
-        name=experiment.name,
+        name=name,
     )
     evaluation["experiment"] = experiment.name
+    if "validation" in meta:  # the best-validated policy: when and how it was chosen
+        evaluation["validation"] = meta["validation"]
     path = run_dir / "evaluation.json"
     write_json(evaluation, path)
     plot_action_histogram(
         evaluation["rows"],
         run_dir / "actions.png",
-        title=f"{experiment.name}: actions over {settings.eval_episodes} deterministic episodes",
+        title=f"{name}: actions over {settings.eval_episodes} deterministic episodes",
     )
-    result.files["evaluation"] = path
-    result.files["actions"] = run_dir / "actions.png"
+    suffix = f"_{label}" if label else ""
+    result.files[f"evaluation{suffix}"] = path
+    result.files[f"actions{suffix}"] = run_dir / "actions.png"
     return evaluation
 
 
