@@ -51,6 +51,7 @@ def test_scores_are_logged_and_the_best_policy_is_kept(validated_run: tuple) -> 
     records = read_validation_log(run_dir)
     assert [r["step"] for r in records] == [300, 600, 900]
     assert all(r["episodes"] == 3 and r["seed"] == 1000 for r in records)
+    assert all(r["map_mode"] == "static" for r in records)
     best_meta = json.loads((run_dir / "best" / "model.json").read_text())
     best_record = max(records, key=lambda r: r["mean_reward"])  # the first of equal scores
     assert best_meta["validation"] == best_record
@@ -88,6 +89,21 @@ def test_validation_does_not_change_training(validated_run: tuple, tmp_path: Pat
     assert torch.equal(weights[0], weights[1])
     assert not (tmp_path / "plain" / "best").exists()
     assert plain.best_evaluation is None
+
+
+def test_evaluation_map_mode_can_differ_from_training(tmp_path: Path) -> None:
+    from frontier_marl.training.train import train
+
+    dynamic = experiment(total_timesteps=300, eval_map_mode="static")
+    dynamic = experiment_from_dict({**dynamic.to_dict(), "env": {**SMALL, "map_mode": "dynamic"}})
+    result = train(dynamic, tmp_path / "run", progress_bar=False)
+    assert read_validation_log(tmp_path / "run")[0]["map_mode"] == "dynamic"
+    for folder in (tmp_path / "run", tmp_path / "run" / "best"):
+        evaluation = json.loads((folder / "evaluation.json").read_text())
+        assert evaluation["env_config"]["map_mode"] == "static"
+    assert result.evaluation["model"]["map_mode"] == "static"
+    with pytest.raises(ValueError, match="train.eval_map_mode must be one of"):
+        TrainSettings(eval_map_mode="fixed")
 
 
 def test_cli_evaluates_the_best_policy_folder(validated_run: tuple, capsys) -> None:

@@ -58,6 +58,9 @@ _RESERVED_DQN = {
 }
 
 
+EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
+
+
 @dataclass(frozen=True)
 class TrainSettings:
     """Budget and bookkeeping of one training run.
@@ -72,6 +75,9 @@ class TrainSettings:
         log_interval: episodes between logger dumps (TensorBoard and metrics.jsonl).
         eval_episodes: episodes of the final deterministic evaluation (0 skips it).
         eval_seed: first seed of the evaluation episodes.
+        eval_map_mode: map mode of the final evaluation: ``as-trained`` (the default),
+            ``static`` (the thesis protocol, e.g. after training on dynamic maps) or ``dynamic``.
+            Validation always uses the training env.
         torch_threads: ``torch.set_num_threads`` value (1 is fastest for this small MLP).
         device: torch device of the model.
         bootstrap_truncations: pass truncations to SB3 as truncations (``TimeLimit.truncated``,
@@ -94,6 +100,7 @@ class TrainSettings:
     log_interval: int = 10
     eval_episodes: int = 30
     eval_seed: int = 0
+    eval_map_mode: str = "as-trained"
     torch_threads: int = 1
     device: str = "cpu"
     bootstrap_truncations: bool = True
@@ -135,6 +142,11 @@ class TrainSettings:
                     f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
                     "on the evaluation episodes would bias the evaluation"
                 )
+        if self.eval_map_mode not in EVAL_MAP_MODES:
+            raise ValueError(
+                f"train.eval_map_mode must be one of {', '.join(EVAL_MAP_MODES)}, "
+                f"got {self.eval_map_mode!r}"
+            )
         if not isinstance(self.device, str) or not self.device:
             raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
 

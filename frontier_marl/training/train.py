@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import make_config
 from frontier_marl.training.checkpoints import (
     MODEL_FILE,
     Checkpoint,
@@ -51,6 +52,7 @@ RESUMABLE_TRAIN_KEYS = {
     "log_interval",
     "eval_episodes",
     "eval_seed",
+    "eval_map_mode",
     "torch_threads",
 }
 
@@ -265,8 +267,11 @@ def train(
     )
     _plot_learning_curve(run_dir, experiment, result)
     if not interrupted and settings.eval_episodes > 0:
+        eval_cfg = cfg
+        if settings.eval_map_mode != "as-trained":
+            eval_cfg = make_config(config=cfg, map_mode=settings.eval_map_mode)
         result.evaluation = _final_evaluation(
-            model, model_path, meta, cfg, settings, run_dir, experiment, result
+            model, model_path, meta, eval_cfg, settings, run_dir, experiment, result
         )
         best = run_dir / BEST_DIR / MODEL_FILE
         if settings.validate_every > 0 and best.is_file():
@@ -277,7 +282,7 @@ def train(
                 loaded.model,
                 best,
                 loaded.metadata or {},
-                cfg,
+                eval_cfg,
                 settings,
                 run_dir / BEST_DIR,
                 experiment,

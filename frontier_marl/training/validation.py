@@ -82,6 +82,7 @@ class BestPolicyKeeper:
             "terminations": result.terminations,
             "episodes": self.episodes,
             "seed": self.seed,
+            "map_mode": self.cfg.map_mode,
         }
         with self.log_path.open("a") as handle:
             handle.write(json.dumps(record) + "\n")
