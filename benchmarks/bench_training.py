@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     report["stages"] = {  # without each stage's first call (one-time costs, kernel loading)
         name: {
-            "calls": timer.calls - 1,
+            "calls": max(timer.calls - 1, 0),
             "us_per_call": round(later / max(timer.calls - 1, 1) * 1e6, 1),
             "us_per_env_step": round(later / max(env_timer.calls, 1) * 1e6, 1),
             "first_call_ms": round(timer.first_call_seconds * 1e3, 1),
