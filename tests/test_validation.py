@@ -167,3 +167,10 @@ def test_resume_keeps_a_best_policy_only_from_before_the_checkpoint(
         assert keeper.best_score == 1.5 and (tmp_path / "best").is_dir()
     else:  # saved by a session that was not continued: dropped
         assert keeper.best_score == -math.inf and not (tmp_path / "best").exists()
+
+
+def test_periodic_callback_needs_a_positive_interval() -> None:
+    from frontier_marl.training.callbacks import Periodic
+
+    with pytest.raises(ValueError, match="interval of a periodic callback must be >= 1"):
+        Periodic(0, print)

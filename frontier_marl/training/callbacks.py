@@ -12,16 +12,20 @@ from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.logger import KVWriter
 
 
-class PeriodicCheckpoint(BaseCallback):
-    """Calls ``save(model)`` every ``every`` environment steps (counted from step 0, so a
-    resumed run keeps the same checkpoint steps)."""
+class Periodic(BaseCallback):
+    """Calls ``action(model)`` every ``every`` environment steps, counted from step 0 (so a
+    resumed run keeps the same steps); with ``log_key``, logs what it returns under that key.
+    Runs the periodic checkpoints and validations of a training run."""
 
-    def __init__(self, every: int, save: Callable[[Any], Any]) -> None:
+    def __init__(
+        self, every: int, action: Callable[[Any], Any], log_key: str | None = None
+    ) -> None:
         super().__init__()
         if every < 1:
-            raise ValueError(f"checkpoint interval must be >= 1, got {every}")
+            raise ValueError(f"the interval of a periodic callback must be >= 1, got {every}")
         self.every = every
-        self.save = save
+        self.action = action
+        self.log_key = log_key
         self._next = every
 
     def _on_training_start(self) -> None:
@@ -29,30 +33,9 @@ class PeriodicCheckpoint(BaseCallback):
 
     def _on_step(self) -> bool:
         if self.model.num_timesteps >= self._next:
-            self.save(self.model)
-            self._next = (self.model.num_timesteps // self.every + 1) * self.every
-        return True
-
-
-class PeriodicValidation(BaseCallback):
-    """Every ``every`` environment steps (counted from step 0), calls ``validate(model)``, which
-    scores the greedy policy on held-out episodes, and logs the score as
-    ``eval/validation_mean_reward``."""
-
-    def __init__(self, every: int, validate: Callable[[Any], float]) -> None:
-        super().__init__()
-        if every < 1:
-            raise ValueError(f"validation interval must be >= 1, got {every}")
-        self.every = every
-        self.validate = validate
-        self._next = every
-
-    def _on_training_start(self) -> None:
-        self._next = (self.model.num_timesteps // self.every + 1) * self.every
-
-    def _on_step(self) -> bool:
-        if self.model.num_timesteps >= self._next:
-            self.logger.record("eval/validation_mean_reward", self.validate(self.model))
+            value = self.action(self.model)
+            if self.log_key is not None:
+                self.logger.record(self.log_key, value)
             self._next = (self.model.num_timesteps // self.every + 1) * self.every
         return True
 

@@ -202,16 +202,17 @@ def train(
 
         progress = ProgressBar()
         all_callbacks.append(progress)
-    if settings.checkpoint_every > 0:
-        from frontier_marl.training.callbacks import PeriodicCheckpoint
+    from frontier_marl.training.callbacks import Periodic
 
-        all_callbacks.append(PeriodicCheckpoint(settings.checkpoint_every, checkpoint_now))
+    if settings.checkpoint_every > 0:
+        all_callbacks.append(Periodic(settings.checkpoint_every, checkpoint_now))
     if settings.validate_every > 0:
-        from frontier_marl.training.callbacks import PeriodicValidation
         from frontier_marl.training.validation import BestPolicyKeeper
 
         keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, start_step)
-        all_callbacks.append(PeriodicValidation(settings.validate_every, keeper))
+        all_callbacks.append(
+            Periodic(settings.validate_every, keeper, log_key="eval/validation_mean_reward")
+        )
 
     remaining = settings.total_timesteps - model.num_timesteps
     interrupted = False
