@@ -1,4 +1,4 @@
-"""benchmarks/bench_training.py with a tiny budget: the report and its stage timings."""
+"""The benchmark scripts with tiny budgets: their reports are consistent."""
 
 from __future__ import annotations
 
@@ -43,3 +43,20 @@ def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
     main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
     main(["config01", "--steps", "200", "--stages"])
     assert (world.World.move, engine.step_outcome, engine.ExplorationMDP.reset) == before
+
+
+def test_labelling_benchmark_counts(tmp_path: Path) -> None:
+    main = runpy.run_path(str(REPO / "benchmarks" / "bench_labelling.py"))["main"]
+    out = tmp_path / "labelling.json"
+    assert main(["--steps", "300", "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    rollout = report["rollout"]
+    assert rollout["steps"] == 300
+    assert 0 < rollout["labellings"] <= 300 + 300  # at most one per step and one per reset
+    assert 0 <= rollout["same_frontier"] < rollout["labellings"]
+    assert all(cost > 0 for cost in report["us_per_call"].values())
+    from scipy import ndimage
+
+    from frontier_marl.core import frontiers
+
+    assert frontiers.ndimage.label is ndimage.label  # the counting wrapper was removed
