@@ -21,8 +21,9 @@ from frontier_marl.core.frontiers import (
 )
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.planning import astar
-from frontier_marl.core.sensing import RaycastSensor
+from frontier_marl.core.sensing import RaycastSensor, make_sensor
 from frontier_marl.core.slots import build_slots
+from frontier_marl.core.world import FULL_PATH, World, WorldParams
 
 pytestmark = pytest.mark.skipif(not kernels.NUMBA_AVAILABLE, reason="numba is not installed")
 
@@ -133,6 +134,44 @@ def test_sensing_matches():
         return belief, seen, counts
 
     assert_same(*both(sense_everywhere))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 10**6),
+    n_robots=st.integers(1, 5),
+    cells_per_step=st.sampled_from([1, 2, 3, FULL_PATH]),
+    sensor=st.sampled_from(["square", "raycast"]),
+)
+def test_moves_match(seed, n_robots, cells_per_step, sensor):
+    """The compiled ``World.move`` (plan cache, robots waiting for each other, sensing)."""
+    rng = np.random.default_rng(seed)
+    true_grid = rng.random((9, 11)) < 0.2
+    free = np.argwhere(~true_grid)
+    if len(free) < n_robots:
+        return
+    starts = free[rng.choice(len(free), n_robots, replace=False)]
+    params = WorldParams(make_sensor(sensor, 2), cells_per_step)
+    # Targets: known-free cells (often the same for several robots, so they block each
+    # other), sometimes an unreachable cell or none; some repeated to reuse the plans.
+    choices = [rng.integers(1 << 30) for _ in range(12)]
+
+    def play() -> list:
+        world = World(true_grid, starts, params)
+        trace = []
+        for choice in choices:
+            known = np.argwhere(world.belief == FREE)
+            pick = np.random.default_rng(choice)
+            targets = [
+                None if pick.random() < 0.1 else tuple(int(v) for v in known[pick.integers(3)])
+                for _ in range(n_robots)
+            ]
+            moved = world.move(targets)
+            trace.append((moved.new_cells, moved.paths, moved.reached, world.belief.copy()))
+            trace.append((world.positions.copy(), world.seen.copy(), world.travelled.copy()))
+        return trace
+
+    assert_same(*both(play))
 
 
 @pytest.mark.parametrize(

@@ -21,6 +21,9 @@ from frontier_marl.core.grid import UNKNOWN
 
 class Sensor(Protocol):
     range: int
+    #: The sensor as rays for the compiled kernels (:func:`kernels.raycast_reveal`): cell
+    #: offsets (K, 2) and, per offset, the offsets that must be free to see it (K, L, 2).
+    rays: tuple[np.ndarray, np.ndarray]
 
     def sense(
         self,
@@ -41,6 +44,10 @@ class SquareSensor:
 
     def __init__(self, perception_range: int) -> None:
         self.range = int(perception_range)
+        span = np.arange(-self.range, self.range + 1, dtype=np.int64)
+        offsets = np.stack(np.meshgrid(span, span, indexing="ij"), axis=-1).reshape(-1, 2)
+        # Nothing occludes: the only cell "between" is the origin, the robot's free cell.
+        self.rays = (offsets, np.zeros((len(offsets), 1, 2), dtype=np.int64))
 
     def window(self, shape: tuple[int, int], cell: tuple[int, int]) -> tuple[slice, slice]:
         row, col = cell
@@ -78,6 +85,7 @@ class RaycastSensor:
     def __init__(self, perception_range: int) -> None:
         self.range = int(perception_range)
         self._offsets, self._between = _rays(self.range)
+        self.rays = (self._offsets, self._between)
         self._cache_grid: np.ndarray | None = None
         self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 

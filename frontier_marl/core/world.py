@@ -104,9 +104,23 @@ class World:
         self._fractions: dict[str, float] = {}
         self._fraction_version = -1
         self._targets: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._make_buffers(len(starts))
         self._make_views()
         for agent in range(len(starts)):
             self._sense(agent)
+
+    def _make_buffers(self, n: int) -> None:
+        """Arrays of the compiled ``move``: its plan cache and its outputs."""
+        cells = self._true.size  # a shortest path has at most this many cells
+        budget = self.params.cells_per_step
+        walk = cells if budget == FULL_PATH else min(budget + 1, cells)
+        self._plan_cells = np.zeros((n, cells, 2), dtype=np.int64)
+        self._plan_meta = np.full((n, 5), -1, dtype=np.int64)  # see kernels.walk
+        self._goals = np.full((n, 2), -1, dtype=np.int64)
+        self._new_cells = np.zeros(n, dtype=np.int64)
+        self._walked = np.zeros((n, walk, 2), dtype=np.int64)
+        self._walked_len = np.zeros(n, dtype=np.int64)
+        self._reached = np.zeros(n, dtype=bool)
 
     def _make_views(self) -> None:
         # Read-only views, made once: the arrays behind them are only ever changed in place.
@@ -282,6 +296,8 @@ class World:
         n = self.n_agents
         if len(targets) != n:
             raise ValueError(f"expected {n} targets, got {len(targets)}")
+        if kernels.ENABLED:
+            return self._move_compiled(targets)
         budget = self.params.cells_per_step
         stop = None if budget == FULL_PATH else budget + 1
         remaining: list[list[list[int]]] = []  # the cells this step may enter, per robot
@@ -322,6 +338,34 @@ class World:
         reached = np.array([0 < path_lengths[a] == progress[a] for a in range(n)])
         paths = [np.array(cells, dtype=np.int64) for cells in walked]
         return MoveResult(np.array(new_cells, dtype=np.int64), paths, reached)
+
+    def _move_compiled(self, targets: list[tuple[int, int] | None]) -> MoveResult:
+        """``move`` as one compiled call (:func:`kernels.walk`), same results."""
+        goals = self._goals
+        for agent, target in enumerate(targets):
+            goals[agent] = (-1, -1) if target is None else target
+        offsets, between = self.params.sensor.rays
+        self._version = kernels.walk(
+            self._true,
+            self._belief,
+            self._seen,
+            self._positions,
+            self._travelled,
+            goals,
+            self._plan_cells,
+            self._plan_meta,
+            self._version,
+            self.params.cells_per_step,
+            offsets,
+            between,
+            self._new_cells,
+            self._walked,
+            self._walked_len,
+            self._reached,
+        )
+        walked, lengths = self._walked, self._walked_len.tolist()
+        paths = [walked[agent, :length].copy() for agent, length in enumerate(lengths)]
+        return MoveResult(self._new_cells.copy(), paths, self._reached.copy())
 
     def _sense(self, agent: int, cell: tuple[int, int] | None = None) -> int:
         """Sense from robot ``agent``'s cell (given as ``cell`` when known); count new cells."""
