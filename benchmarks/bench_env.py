@@ -8,7 +8,7 @@
 Reports decisions per second (one decision = one ``step`` of all robots) for a random-valid-slot
 policy and a nearest-cluster policy on the thesis presets and larger maps, and the share of SB3
 DQN training wall time spent in the env: the same DQN trains for the same number of steps on the
-env and on a null env with identical spaces, in one run, and
+env and on a null env with identical spaces, in one run (interleaved in chunks), and
 
     env share = (T_env - T_null) / T_env.
 """
@@ -118,8 +118,14 @@ def decisions_per_second(kwargs: dict[str, Any], policy: Any, seconds: float) ->
     }
 
 
-def dqn_env_share(steps: int) -> dict[str, float]:
-    """Train the thesis's DQN on the env and on a null env with the same spaces."""
+def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, float]:
+    """Train the thesis's DQN on the env and on a null env with the same spaces, interleaved.
+
+    The two models train in alternating chunks of ``steps / chunks`` steps (which one goes
+    first alternates too), each continuing its own run, so both see the same machine: the
+    speed of these shared machines drifts by 10-20 % over tens of seconds, which made two
+    back-to-back runs disagree by several points.
+    """
     import gymnasium as gym
     import torch
     from stable_baselines3 import DQN
@@ -148,9 +154,14 @@ def dqn_env_share(steps: int) -> dict[str, float]:
             self._t += 1
             return self._obs, 0.0, False, self._t >= 100, {}
 
-    timings = {}
-    for name, env in (("null", NullEnv()), ("env", real)):
-        model = DQN(
+    class ChunkedDQN(DQN):
+        """Keeps the schedules (epsilon) of one ``steps``-step run across the chunks."""
+
+        def _update_current_progress_remaining(self, num_timesteps: int, total: int) -> None:
+            super()._update_current_progress_remaining(num_timesteps, steps)
+
+    models = {
+        name: ChunkedDQN(
             "MultiInputPolicy",
             env,
             learning_rate=5e-5,
@@ -164,15 +175,24 @@ def dqn_env_share(steps: int) -> dict[str, float]:
             seed=0,
             verbose=0,
         )
-        start = time.perf_counter()
-        model.learn(total_timesteps=steps)
-        timings[name] = time.perf_counter() - start
+        for name, env in (("null", NullEnv()), ("env", real))
+    }
+    timings = dict.fromkeys(models, 0.0)
+    per_chunk = -(-steps // chunks)
+    for chunk in range(chunks):
+        order = ["null", "env"] if chunk % 2 == 0 else ["env", "null"]
+        for name in order:
+            start = time.perf_counter()
+            models[name].learn(total_timesteps=per_chunk, reset_num_timesteps=chunk == 0)
+            timings[name] += time.perf_counter() - start
     share = (timings["env"] - timings["null"]) / timings["env"]
+    trained = models["env"].num_timesteps
     return {
-        "steps": steps,
+        "steps": trained,
+        "chunks": chunks,
         "seconds_null": timings["null"],
         "seconds_env": timings["env"],
-        "steps_per_s_env": steps / timings["env"],
+        "steps_per_s_env": trained / timings["env"],
         "env_share": share,
     }
 
@@ -181,6 +201,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=8.0, help="timed seconds per setting")
     parser.add_argument("--dqn-steps", type=int, default=30_000)
+    parser.add_argument(
+        "--dqn-chunks", type=int, default=15, help="alternating chunks of the two DQN runs"
+    )
     parser.add_argument("--skip-dqn", action="store_true")
     parser.add_argument(
         "--reference",
@@ -231,7 +254,7 @@ def main() -> None:
         report["dqn"] = []
         for mode in modes:
             with compiled_kernels(mode == "kernels"):
-                dqn = dqn_env_share(args.dqn_steps)
+                dqn = dqn_env_share(args.dqn_steps, args.dqn_chunks)
             report["dqn"].append({"mode": mode, **dqn})
             print(
                 f"DQN {dqn['steps']} steps ({mode}): null env {dqn['seconds_null']:.1f} s, "
