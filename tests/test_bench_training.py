@@ -60,3 +60,21 @@ def test_labelling_benchmark_counts(tmp_path: Path) -> None:
     from frontier_marl.core import frontiers
 
     assert frontiers.ndimage.label is ndimage.label  # the counting wrapper was removed
+
+
+def test_env_share_interleaves_equal_runs() -> None:
+    module = runpy.run_path(str(REPO / "benchmarks" / "bench_env.py"))
+    report = module["dqn_env_share"](600, 3)
+    assert report["steps"] == 600 and report["chunks"] == 3
+    assert report["seconds_null"] > 0 and report["seconds_env"] > 0
+    expected = (report["seconds_env"] - report["seconds_null"]) / report["seconds_env"]
+    assert report["env_share"] == expected
+
+
+def test_minimal_step_plays_the_real_episodes() -> None:
+    """The floor benchmark's minimal step is faithful: the real env's episodes, exactly."""
+    module = runpy.run_path(str(REPO / "benchmarks" / "bench_step_floor.py"))
+    assert module["check_same_episodes"](3) > 20
+    report = module["training_shares"](400, 2)
+    assert report["steps"] == 400
+    assert set(report["env_share"]) == {"env", "minimal", "minimal_without_labelling"}

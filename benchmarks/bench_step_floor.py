@@ -1,0 +1,341 @@
+"""How low can the env's share of DQN training go? A lower bound for issue 2's 15 % target.
+
+    python benchmarks/bench_step_floor.py                 # ~3 minutes on 2 cores
+    python benchmarks/bench_step_floor.py --steps 30000 --chunks 15 --json floor.json
+
+Not a test and not an env to use: ``MinimalStep`` is the thesis's configuration-1 decision step
+(one robot, Reward 2, absolute centroids + agent position, unsorted, the calibrated defaults of
+``thesis-20x20``) written as the smallest Python we could put around the compiled kernels and
+the ``scipy.ndimage.label`` call the design requires: no adapters, no dataclasses, one robot
+only, an info with the issue's required keys. Before timing anything the script checks that it
+plays exactly the episodes of ``FrontierExploreEnv`` (observations, rewards, episode ends,
+action masks, clusters, paths). Then the thesis's DQN trains, interleaved in chunks as in
+``bench_env.py``, on a null env, on the real env, on ``MinimalStep``, and on ``MinimalStep``
+with the labelling skipped after each episode's first (wrong clusters: a cost measurement only),
+and the script reports each one's share of training time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from scipy import ndimage
+
+import frontier_marl
+from frontier_marl.core import kernels
+from frontier_marl.engine import StepInfo
+from frontier_marl.training.experiment import load_experiment
+
+
+class MinimalStep(gym.Env):
+    """Configuration 1's step with the least glue possible (see the module docstring)."""
+
+    relabel = True  # False: reuse the episode's first labelling (cost bound only)
+
+    def __init__(self) -> None:
+        cfg = load_experiment("config01").env_config()
+        self._real = frontier_marl.FrontierExploreEnv(preset=None, config=cfg)
+        obs = cfg.observation
+        if not (obs.centroid == "absolute" and obs.agent_position and not obs.info_gain):
+            raise ValueError("MinimalStep implements configuration 1's observation only")
+        if obs.sort_by_distance or obs.normalize or obs.action_mask or cfg.n_agents != 1:
+            raise ValueError("MinimalStep implements configuration 1 only")
+        self.cfg = cfg
+        self.reward = cfg.reward
+        self.n_slots = cfg.n_slots
+        self.structure = ndimage.generate_binary_structure(2, 2 if cfg.connectivity == 8 else 1)
+        self.observation_space = self._real.observation_space
+        self.action_space = self._real.action_space
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        observation, info = self._real.reset(seed=seed)
+        self.world = self._real.world
+        self._labelled_version = -1
+        self._first_labelling: tuple[np.ndarray, int] | None = None
+        self.steps = 0
+        self.without_progress = 0
+        self.history: tuple[tuple[int, int] | None, ...] = ()
+        self._refresh()
+        return observation, info
+
+    def _label(self, mask: np.ndarray) -> tuple[np.ndarray, int]:
+        if self.relabel or self._first_labelling is None:
+            image, count = ndimage.label(mask, structure=self.structure)
+            self._first_labelling = (image, count)
+            return image, count
+        image = self._first_labelling[0].copy()
+        image[mask] = 1
+        return image, 1
+
+    def _refresh(self) -> None:
+        world = self.world
+        if world._version != self._labelled_version:
+            mask, rows, cols = kernels.frontier_cells(world._belief)
+            if len(rows):
+                image, count = self._label(mask)
+                cluster, sizes, centroids = kernels.clusters_from_labels(
+                    image, rows, cols, count, self.cfg.max_cluster_cells
+                )
+            else:
+                cluster = sizes = rows
+                centroids = np.zeros((0, 2))
+            self._clusters = (rows, cols, cluster, centroids, sizes, sizes.astype(float))
+            self._labelled_version = world._version
+        rows, cols, cluster, centroids, sizes, gains = self._clusters
+        position = world._positions[0]
+        self.slots = kernels.robot_slots(
+            world._belief,
+            position[0],
+            position[1],
+            rows,
+            cols,
+            cluster,
+            centroids,
+            sizes,
+            gains,
+            self.n_slots,
+            False,
+        )
+        self.live = int(np.count_nonzero(self.slots[1]))
+
+    def step(self, action: Any) -> Any:
+        slot = int(action)
+        if not 0 <= slot < self.n_slots:
+            raise ValueError(f"action must be in [0, {self.n_slots - 1}], got {action!r}")
+        world, reward_cfg = self.world, self.reward
+        goals = world._goals
+        if slot < self.live:
+            row, col = self.slots[3][slot].tolist()
+            target: tuple[int, int] | None = (row, col)
+            goals[0] = target
+            padding = False
+        else:
+            target = None
+            goals[0] = -1
+            padding = self.live > 0
+        history = self.history
+        oscillation = (
+            target is not None
+            and bool(history)
+            and history[-1] is not None
+            and target != history[-1]
+            and target in history[:-1]
+        )
+        self.history = (*history, target)[-(reward_cfg.oscillation_window + 1) :]
+        offsets, between = world.params.sensor.rays
+        world._version = kernels.walk(
+            world._true,
+            world._belief,
+            world._seen,
+            world._positions,
+            world._travelled,
+            goals,
+            world._plan_cells,
+            world._plan_meta,
+            world._version,
+            world.params.cells_per_step,
+            offsets,
+            between,
+            world._new_cells,
+            world._walked,
+            world._walked_len,
+            world._reached,
+        )
+        new = int(world._new_cells[0])
+        self.steps += 1
+        self.without_progress = 0 if new else self.without_progress + 1
+        self._refresh()
+        known = kernels.count_known(world._belief, world._start_region)
+        fraction = known / max(world._start_region_size, 1)
+        reward = reward_cfg.cell_reward * new
+        if new == 0:
+            reward += reward_cfg.no_new_cell_penalty
+        if padding:
+            reward += reward_cfg.padding
+        if oscillation:
+            reward += reward_cfg.oscillation_penalty
+        terminated = truncated = False
+        if fraction >= reward_cfg.explore_threshold:
+            reward += reward_cfg.goal_bonus
+            terminated = True
+        elif not self.live:
+            terminated = True
+        else:
+            if self.without_progress >= reward_cfg.no_progress_limit:
+                reward += reward_cfg.no_progress_penalty
+                truncated = True
+            if self.steps >= reward_cfg.max_steps:
+                reward += reward_cfg.step_limit_penalty
+                truncated = True
+        cluster, valid, centroid, target_cells, distance, size, gain = self.slots
+        live = self.live
+        features = np.zeros((self.n_slots, 2), dtype=np.float32)
+        features[:live] = centroid[:live]
+        observation = {
+            "clusters": features.ravel(),
+            "agent_position": world._positions[0].astype(np.float32),
+        }
+        mask = valid.astype(np.int8)
+        if not live:
+            mask[0] = 1
+        info = StepInfo(
+            explored_fraction=fraction,
+            new_cells=new,
+            action_mask=mask,
+            clusters=[
+                {
+                    "slot": s,
+                    "cluster": k,
+                    "centroid": tuple(c),
+                    "target": tuple(t),
+                    "size": n,
+                    "gain": g,
+                    "distance": d,
+                }
+                for s, k, c, t, n, g, d in zip(  # noqa: B905 - stops after the live slots
+                    range(live),
+                    cluster.tolist(),
+                    centroid.tolist(),
+                    target_cells.tolist(),
+                    size.tolist(),
+                    gain.tolist(),
+                    distance.tolist(),
+                )
+            ],
+            path=world._walked[0, : world._walked_len[0]].copy(),
+            target=target,
+        )
+        return observation, float(reward), terminated, truncated, info
+
+
+def check_same_episodes(episodes: int) -> int:
+    """Play random-action episodes on the real env and on ``MinimalStep``; they must match."""
+    cfg = load_experiment("config01").env_config()
+    real = frontier_marl.FrontierExploreEnv(preset=None, config=cfg)
+    minimal = MinimalStep()
+    steps = 0
+    for seed in range(episodes):
+        got, expected = minimal.reset(seed=seed), real.reset(seed=seed)
+        rng = np.random.default_rng(seed)
+        done = False
+        while not done:
+            action = int(rng.integers(cfg.n_slots))
+            got, expected = minimal.step(action), real.step(action)
+            for key in ("clusters", "agent_position"):
+                np.testing.assert_array_equal(got[0][key], expected[0][key])
+            assert got[1:4] == expected[1:4], (seed, steps, got[1:4], expected[1:4])
+            for key in ("new_cells", "clusters", "target"):
+                assert got[4][key] == expected[4][key], (seed, steps, key)
+            for key in ("action_mask", "path"):
+                np.testing.assert_array_equal(got[4][key], expected[4][key])
+            done = got[2] or got[3]
+            steps += 1
+    return steps
+
+
+class NullEnv(gym.Env):
+    """Same spaces, constant observation, 100-step episodes, no simulation."""
+
+    def __init__(self, like: gym.Env) -> None:
+        self.observation_space = like.observation_space
+        self.action_space = like.action_space
+        self._obs = self.observation_space.sample()
+        self._t = 0
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        super().reset(seed=seed)
+        self._t = 0
+        return self._obs, {}
+
+    def step(self, action: Any) -> Any:
+        self._t += 1
+        return self._obs, 0.0, False, self._t >= 100, {}
+
+
+def training_shares(steps: int, chunks: int) -> dict[str, Any]:
+    """Train the thesis's DQN on each env, interleaved in chunks; seconds and env shares."""
+    import torch
+    from stable_baselines3 import DQN
+
+    class ChunkedDQN(DQN):
+        """Keeps the schedules (epsilon) of one ``steps``-step run across the chunks."""
+
+        def _update_current_progress_remaining(self, num_timesteps: int, total: int) -> None:
+            super()._update_current_progress_remaining(num_timesteps, steps)
+
+    torch.set_num_threads(1)
+    cfg = load_experiment("config01").env_config()
+    real = frontier_marl.FrontierExploreEnv(preset=None, config=cfg)
+    unlabelled = MinimalStep()
+    unlabelled.relabel = False
+    envs: dict[str, gym.Env] = {
+        "null": NullEnv(real),
+        "env": real,
+        "minimal": MinimalStep(),
+        "minimal_without_labelling": unlabelled,
+    }
+    models = {}
+    for name, env in envs.items():
+        env.reset(seed=0)  # loads the compiled kernels, outside the timing
+        models[name] = ChunkedDQN(
+            "MultiInputPolicy",
+            env,
+            learning_rate=5e-5,
+            exploration_fraction=0.7,
+            exploration_final_eps=0.05,
+            batch_size=64,
+            buffer_size=50_000,
+            target_update_interval=500,
+            train_freq=4,
+            learning_starts=1000,
+            seed=0,
+            verbose=0,
+        )
+    names = list(envs)
+    seconds = dict.fromkeys(names, 0.0)
+    per_chunk = -(-steps // chunks)
+    for chunk in range(chunks):
+        shift = chunk % len(names)
+        for name in names[shift:] + names[:shift]:
+            start = time.perf_counter()
+            models[name].learn(total_timesteps=per_chunk, reset_num_timesteps=chunk == 0)
+            seconds[name] += time.perf_counter() - start
+    return {
+        "steps": models["env"].num_timesteps,
+        "chunks": chunks,
+        "seconds": seconds,
+        "env_share": {
+            name: (seconds[name] - seconds["null"]) / seconds[name]
+            for name in names
+            if name != "null"
+        },
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=30_000)
+    parser.add_argument("--chunks", type=int, default=15)
+    parser.add_argument("--check-episodes", type=int, default=30)
+    parser.add_argument("--json", help="write the figures to this file")
+    args = parser.parse_args()
+    checked = check_same_episodes(args.check_episodes)
+    print(f"MinimalStep plays the real env's episodes exactly ({checked} steps checked)")
+    report = training_shares(args.steps, args.chunks)
+    report["steps_checked"] = checked
+    for name, second in report["seconds"].items():
+        share = report["env_share"].get(name)
+        text = "" if share is None else f"  env share {100 * share:.1f} %"
+        print(f"{name:>26}: {second:6.1f} s{text}")
+    if args.json:
+        with open(args.json, "w") as handle:
+            json.dump(report, handle, indent=2)
+
+
+if __name__ == "__main__":
+    main()
