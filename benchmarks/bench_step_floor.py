@@ -12,7 +12,8 @@ plays exactly the episodes of ``FrontierExploreEnv`` (observations, rewards, epi
 action masks, clusters, paths). Then the thesis's DQN trains, interleaved in chunks as in
 ``bench_env.py``, on a null env, on the real env, on ``MinimalStep``, and on ``MinimalStep``
 with the labelling skipped after each episode's first (wrong clusters: a cost measurement only),
-and the script reports each one's share of training time.
+and the script reports each one's share of training time (and the two steps' cost outside
+training).
 """
 
 from __future__ import annotations
@@ -238,6 +239,22 @@ def check_same_episodes(episodes: int) -> int:
     return steps
 
 
+def warm_us_per_step(env: gym.Env, steps: int) -> float:
+    """Microseconds per ``step`` outside training (random actions, resets not timed)."""
+    rng = np.random.default_rng(0)
+    env.reset(seed=0)
+    elapsed, seed = 0.0, 0
+    for _ in range(steps):
+        action = int(rng.integers(env.action_space.n))
+        start = time.perf_counter()
+        _, _, terminated, truncated, _ = env.step(action)
+        elapsed += time.perf_counter() - start
+        if terminated or truncated:
+            seed += 1
+            env.reset(seed=seed)
+    return 1e6 * elapsed / steps
+
+
 class NullEnv(gym.Env):
     """Same spaces, constant observation, 100-step episodes, no simulation."""
 
@@ -326,8 +343,15 @@ def main() -> None:
     args = parser.parse_args()
     checked = check_same_episodes(args.check_episodes)
     print(f"MinimalStep plays the real env's episodes exactly ({checked} steps checked)")
+    cfg = load_experiment("config01").env_config()
+    warm = {
+        "env": warm_us_per_step(frontier_marl.FrontierExploreEnv(preset=None, config=cfg), 20_000),
+        "minimal": warm_us_per_step(MinimalStep(), 20_000),
+    }
+    print(f"µs per step outside training: env {warm['env']:.1f}, minimal {warm['minimal']:.1f}")
     report = training_shares(args.steps, args.chunks)
     report["steps_checked"] = checked
+    report["warm_us_per_step"] = warm
     for name, second in report["seconds"].items():
         share = report["env_share"].get(name)
         text = "" if share is None else f"  env share {100 * share:.1f} %"
