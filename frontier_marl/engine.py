@@ -141,8 +141,8 @@ class ExplorationMDP:
             slot = self._check_action(action, agent)
             table = self._slots[agent]
             if slot < table.live:  # live slots come first
-                row, col = table.target[slot]
-                targets.append((int(row), int(col)))
+                row, col = table.target[slot].tolist()
+                targets.append((row, col))
                 padding.append(False)
             else:
                 targets.append(None)

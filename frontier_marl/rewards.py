@@ -26,7 +26,6 @@ penalty. The episode also terminates when no robot has a reachable frontier left
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -41,7 +40,7 @@ class OscillationDetector:
 
     def __init__(self, window: int) -> None:
         self.window = window
-        self._history: deque[tuple[int, int] | None] = deque(maxlen=window + 1)
+        self._history: tuple[tuple[int, int] | None, ...] = ()  # the last window + 1 targets
 
     def update(self, target: tuple[int, int] | None) -> bool:
         history = self._history
@@ -50,10 +49,10 @@ class OscillationDetector:
             and len(history) > 0
             and history[-1] is not None
             and target != history[-1]
-            and target in list(history)[:-1]
+            and target in history[:-1]
         )
-        history.append(target)
-        return bool(oscillates)
+        self._history = (*history[-self.window :], target) if self.window else (target,)
+        return oscillates
 
 
 @dataclass(frozen=True, slots=True)
