@@ -177,15 +177,20 @@ def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, float]:
         )
         for name, env in (("null", NullEnv()), ("env", real))
     }
-    timings = dict.fromkeys(models, 0.0)
+    chunk_seconds: dict[str, list[float]] = {name: [] for name in models}
     per_chunk = -(-steps // chunks)
     for chunk in range(chunks):
         order = ["null", "env"] if chunk % 2 == 0 else ["env", "null"]
         for name in order:
             start = time.perf_counter()
             models[name].learn(total_timesteps=per_chunk, reset_num_timesteps=chunk == 0)
-            timings[name] += time.perf_counter() - start
+            chunk_seconds[name].append(time.perf_counter() - start)
+    timings = {name: sum(seconds) for name, seconds in chunk_seconds.items()}
     share = (timings["env"] - timings["null"]) / timings["env"]
+    # The spread of the share between chunk pairs tells how far to trust it on this machine.
+    chunk_shares = np.array(
+        [(e - n) / e for n, e in zip(chunk_seconds["null"], chunk_seconds["env"], strict=True)]
+    )
     trained = models["env"].num_timesteps
     return {
         "steps": trained,
@@ -194,6 +199,10 @@ def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, float]:
         "seconds_env": timings["env"],
         "steps_per_s_env": trained / timings["env"],
         "env_share": share,
+        "env_share_standard_error": float(chunk_shares.std(ddof=1) / np.sqrt(chunks))
+        if chunks > 1
+        else float("nan"),
+        "env_share_by_chunk": chunk_shares.tolist(),
     }
 
 
@@ -259,7 +268,8 @@ def main() -> None:
             print(
                 f"DQN {dqn['steps']} steps ({mode}): null env {dqn['seconds_null']:.1f} s, "
                 f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
-                f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} %"
+                f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} % "
+                f"(standard error over the chunks {100 * dqn['env_share_standard_error']:.1f})"
             )
     if args.json:
         with open(args.json, "w") as handle:

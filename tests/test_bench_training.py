@@ -69,6 +69,8 @@ def test_env_share_interleaves_equal_runs() -> None:
     assert report["seconds_null"] > 0 and report["seconds_env"] > 0
     expected = (report["seconds_env"] - report["seconds_null"]) / report["seconds_env"]
     assert report["env_share"] == expected
+    assert len(report["env_share_by_chunk"]) == 3
+    assert report["env_share_standard_error"] >= 0
 
 
 def test_minimal_step_plays_the_real_episodes() -> None:
