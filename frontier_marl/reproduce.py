@@ -150,7 +150,8 @@ def format_comparison_markdown(table: Mapping[str, Any]) -> str:
         "every policy.",
         f"DQN: {training['config']} ({training['description']}), seed {training['seed']}, "
         f"{training['steps']} training steps (thesis: {training['thesis_steps']}), "
-        f"{training['wall_time_s']:.0f} s of training.",
+        f"{training['wall_time_s']:.0f} s of training. The DQN row is the run's "
+        f"{training.get('reported_policy', 'final model')}.",
         "",
         "| " + " | ".join(header for _key, header in COLUMNS) + " |",
         "|" + "---|" * len(COLUMNS),
@@ -231,9 +232,23 @@ def reproduce(
 
     log("[3/3] comparison table and figures")
     evaluation = trained.evaluation
+    best = trained.best_evaluation
     thesis_dqn = THESIS_DQN_RESULTS.get(experiment.name)
-    dqn = comparison_row(evaluation["model"], "dqn", thesis_dqn, name=f"DQN {experiment.name}")
+    # With validation (train.validate_every) the reported policy is the best-validated one,
+    # chosen on held-out episodes, never the protocol's; the final model is shown below it.
+    reported = evaluation if best is None else best
+    dqn = comparison_row(reported["model"], "dqn", thesis_dqn, name=f"DQN {experiment.name}")
     rows = [dqn]
+    if best is not None:
+        final_name = f"DQN {experiment.name}, final model"
+        rows.append(comparison_row(evaluation["model"], "dqn", None, name=final_name))
+    selection = (
+        "final model"
+        if best is None
+        else f"best-validated policy (step {best['validation']['step']}, validation mean "
+        f"{best['validation']['mean_reward']:.2f} on reset seeds "
+        f"{best['validation']['seed']}+)"
+    )
     for row in baseline_rows:
         thesis = (
             None
@@ -263,6 +278,7 @@ def reproduce(
         "training": {
             "config": experiment.name,
             "description": experiment.description,
+            "reported_policy": selection,
             "seed": seed,
             "steps": trained.num_timesteps,
             "thesis_steps": (thesis_dqn or {}).get("steps", 1_000_000),
@@ -272,7 +288,7 @@ def reproduce(
             "source": experiment.source,
         },
         "summary": summary_row(
-            evaluation,
+            reported,
             config=experiment.name,
             seed=seed,
             steps=trained.num_timesteps,
@@ -290,7 +306,7 @@ def reproduce(
     files["json"] = write_json(table, out / "comparison.json")
     files["baselines"] = out / "baselines.json"
     files["baselines"].write_text(dumps_rows(baseline_rows))
-    files.update(_figures(out, table, evaluation, baseline_rows, trained, experiment.name))
+    files.update(_figures(out, table, reported, baseline_rows, trained, experiment.name))
     files["run_dir"] = run_dir
     return result
 

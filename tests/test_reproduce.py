@@ -180,3 +180,42 @@ def test_config_names_resolve_from_any_directory(
     assert REPO / "training" in config_folders()
     with pytest.raises(ValueError, match="pip install -e"):
         resolve_config_path("no-such-config")
+
+
+def test_reproduce_reports_the_best_validated_policy_beside_the_final_model(
+    tmp_path: Path,
+) -> None:
+    config = tmp_path / "validated.toml"
+    config.write_text(
+        'name = "config01"\n'
+        'description = "configuration 1 with validation"\n'
+        '[env]\npreset = "thesis-20x20"\ncentroid = "absolute"\nagent_position = true\n'
+        'info_gain = false\nsort_by_distance = false\nreward = "reward2"\n'
+        "[train]\nvalidate_every = 500\nvalidation_episodes = 2\n"
+    )
+    result = reproduce(
+        tmp_path / "out",
+        steps=1000,
+        episodes=2,
+        config=config,
+        heuristics=("greedy-distance",),
+        progress=False,
+        log=lambda _line: None,
+    )
+    table = result.table
+    assert table is not None
+    rows = table["rows"]
+    assert [row["policy"] for row in rows] == [
+        "DQN config01",
+        "DQN config01, final model",
+        "greedy-distance",
+    ]
+    best = json.loads((result.run_dir / "best" / "evaluation.json").read_text())
+    final = json.loads((result.run_dir / "evaluation.json").read_text())
+    assert rows[0]["mean_reward"] == best["model"]["mean_reward"]
+    assert rows[1]["mean_reward"] == final["model"]["mean_reward"]
+    assert rows[0]["thesis_mean"] == 15.55 and rows[1]["thesis_mean"] is None
+    step = best["validation"]["step"]
+    assert table["training"]["reported_policy"].startswith(f"best-validated policy (step {step},")
+    assert table["summary"]["mean_reward"] == best["model"]["mean_reward"]
+    assert "best-validated policy" in (result.out / "comparison.md").read_text()
