@@ -15,7 +15,8 @@ from pathlib import Path
 #: name -> one-line description
 PRETRAINED: dict[str, str] = {
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
-    "Reward 2), 1e6 steps on thesis-20x20, seed 0",
+    "Reward 2, normalized), the best-validated policy of a 1e6-step run on thesis-20x20 "
+    "(seed 0, step 500,000)",
 }
 
 
