@@ -44,9 +44,11 @@ class MinimalStep(gym.Env):
         obs = cfg.observation
         if not (obs.centroid == "absolute" and obs.agent_position and not obs.info_gain):
             raise ValueError("MinimalStep implements configuration 1's observation only")
-        if obs.sort_by_distance or obs.normalize or obs.action_mask or cfg.n_agents != 1:
+        if obs.sort_by_distance or obs.action_mask or cfg.n_agents != 1:
             raise ValueError("MinimalStep implements configuration 1 only")
         self.cfg = cfg
+        # Positions divided by the grid size with ``normalize`` (in float64, then float32).
+        self.scale = np.array([cfg.height, cfg.width], float) if obs.normalize else np.ones(2)
         self.reward = cfg.reward
         self.n_slots = cfg.n_slots
         self.structure = ndimage.generate_binary_structure(2, 2 if cfg.connectivity == 8 else 1)
@@ -175,11 +177,11 @@ class MinimalStep(gym.Env):
                 truncated = True
         cluster, valid, centroid, target_cells, distance, size, gain = self.slots
         live = self.live
-        features = np.zeros((self.n_slots, 2), dtype=np.float32)
+        features = np.zeros((self.n_slots, 2))
         features[:live] = centroid[:live]
         observation = {
-            "clusters": features.ravel(),
-            "agent_position": world._positions[0].astype(np.float32),
+            "clusters": (features / self.scale).astype(np.float32).ravel(),
+            "agent_position": (world._positions[0] / self.scale).astype(np.float32),
         }
         mask = valid.astype(np.int8)
         if not live:
