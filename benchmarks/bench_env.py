@@ -24,6 +24,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 import frontier_marl
@@ -118,80 +119,86 @@ def decisions_per_second(kwargs: dict[str, Any], policy: Any, seconds: float) ->
     }
 
 
-def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, float]:
-    """Train the thesis's DQN on the env and on a null env with the same spaces, interleaved.
+class NullEnv(gym.Env):
+    """Same spaces as ``like``, constant observation, 100-step episodes, no simulation."""
 
-    The two models train in alternating chunks of ``steps / chunks`` steps (which one goes
-    first alternates too), each continuing its own run, so both see the same machine: the
-    speed of these shared machines drifts by 10-20 % over tens of seconds, which made two
-    back-to-back runs disagree by several points.
-    """
-    import gymnasium as gym
+    def __init__(self, like: gym.Env) -> None:
+        self.observation_space = like.observation_space
+        self.action_space = like.action_space
+        self._obs = self.observation_space.sample()
+        self._t = 0
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        super().reset(seed=seed)
+        self._t = 0
+        return self._obs, {}
+
+    def step(self, action: Any) -> Any:
+        self._t += 1
+        return self._obs, 0.0, False, self._t >= 100, {}
+
+
+def thesis_dqn(env: gym.Env, steps: int) -> Any:
+    """The thesis's DQN on ``env`` (one torch thread), keeping the schedules (epsilon) of one
+    ``steps``-step run when it is trained in chunks."""
     import torch
     from stable_baselines3 import DQN
 
-    torch.set_num_threads(1)
-    real = frontier_marl.FrontierExploreEnv(preset="thesis-20x20")
-    # One-time costs stay out of the timing: the first reset of a process loads the compiled
-    # kernels (~0.25 s, once per process: 0.04 % of a 1e6-step run, but ~1.5 % of a short one).
-    real.reset(seed=0)
-
-    class NullEnv(gym.Env):
-        """Same spaces, constant observation, 100-step episodes, no simulation."""
-
-        def __init__(self) -> None:
-            self.observation_space = real.observation_space
-            self.action_space = real.action_space
-            self._obs = self.observation_space.sample()
-            self._t = 0
-
-        def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
-            super().reset(seed=seed)
-            self._t = 0
-            return self._obs, {}
-
-        def step(self, action: Any) -> Any:
-            self._t += 1
-            return self._obs, 0.0, False, self._t >= 100, {}
-
     class ChunkedDQN(DQN):
-        """Keeps the schedules (epsilon) of one ``steps``-step run across the chunks."""
-
         def _update_current_progress_remaining(self, num_timesteps: int, total: int) -> None:
             super()._update_current_progress_remaining(num_timesteps, steps)
 
-    models = {
-        name: ChunkedDQN(
-            "MultiInputPolicy",
-            env,
-            learning_rate=5e-5,
-            exploration_fraction=0.7,
-            exploration_final_eps=0.05,
-            batch_size=64,
-            buffer_size=50_000,
-            target_update_interval=500,
-            train_freq=4,
-            learning_starts=1000,
-            seed=0,
-            verbose=0,
-        )
-        for name, env in (("null", NullEnv()), ("env", real))
-    }
-    chunk_seconds: dict[str, list[float]] = {name: [] for name in models}
+    torch.set_num_threads(1)
+    return ChunkedDQN(
+        "MultiInputPolicy",
+        env,
+        learning_rate=5e-5,
+        exploration_fraction=0.7,
+        exploration_final_eps=0.05,
+        batch_size=64,
+        buffer_size=50_000,
+        target_update_interval=500,
+        train_freq=4,
+        learning_starts=1000,
+        seed=0,
+        verbose=0,
+    )
+
+
+def train_interleaved(envs: dict[str, gym.Env], steps: int, chunks: int) -> dict[str, list[float]]:
+    """Train one thesis DQN per env in rotating chunks of ``steps / chunks`` steps, each model
+    continuing its own run, so the drifting speed of these shared machines hits all alike;
+    the seconds of every chunk, by env name."""
+    models = {}
+    for name, env in envs.items():
+        # One-time costs stay out of the timing: the first reset of a process loads the
+        # compiled kernels (~0.25 s, once per process, but ~1.5 % of a short run).
+        env.reset(seed=0)
+        models[name] = thesis_dqn(env, steps)
+    names = list(models)
+    seconds: dict[str, list[float]] = {name: [] for name in names}
     per_chunk = -(-steps // chunks)
     for chunk in range(chunks):
-        order = ["null", "env"] if chunk % 2 == 0 else ["env", "null"]
-        for name in order:
+        shift = chunk % len(names)
+        for name in names[shift:] + names[:shift]:
             start = time.perf_counter()
             models[name].learn(total_timesteps=per_chunk, reset_num_timesteps=chunk == 0)
-            chunk_seconds[name].append(time.perf_counter() - start)
-    timings = {name: sum(seconds) for name, seconds in chunk_seconds.items()}
+            seconds[name].append(time.perf_counter() - start)
+    return seconds
+
+
+def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, Any]:
+    """Train the thesis's DQN on the env and on a null env with the same spaces, interleaved
+    (:func:`train_interleaved`): back-to-back runs disagreed by several points."""
+    real = frontier_marl.FrontierExploreEnv(preset="thesis-20x20")
+    seconds = train_interleaved({"null": NullEnv(real), "env": real}, steps, chunks)
+    timings = {name: sum(chunk) for name, chunk in seconds.items()}
     share = (timings["env"] - timings["null"]) / timings["env"]
     # The spread of the share between chunk pairs tells how far to trust it on this machine.
     chunk_shares = np.array(
-        [(e - n) / e for n, e in zip(chunk_seconds["null"], chunk_seconds["env"], strict=True)]
+        [(e - n) / e for n, e in zip(seconds["null"], seconds["env"], strict=True)]
     )
-    trained = models["env"].num_timesteps
+    trained = chunks * -(-steps // chunks)
     return {
         "steps": trained,
         "chunks": chunks,

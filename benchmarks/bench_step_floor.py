@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -31,6 +33,9 @@ import frontier_marl
 from frontier_marl.core import kernels
 from frontier_marl.engine import StepInfo
 from frontier_marl.training.experiment import load_experiment
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_env.py lies beside this script
+from bench_env import NullEnv, train_interleaved  # noqa: E402
 
 
 class MinimalStep(gym.Env):
@@ -257,37 +262,8 @@ def warm_us_per_step(env: gym.Env, steps: int) -> float:
     return 1e6 * elapsed / steps
 
 
-class NullEnv(gym.Env):
-    """Same spaces, constant observation, 100-step episodes, no simulation."""
-
-    def __init__(self, like: gym.Env) -> None:
-        self.observation_space = like.observation_space
-        self.action_space = like.action_space
-        self._obs = self.observation_space.sample()
-        self._t = 0
-
-    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
-        super().reset(seed=seed)
-        self._t = 0
-        return self._obs, {}
-
-    def step(self, action: Any) -> Any:
-        self._t += 1
-        return self._obs, 0.0, False, self._t >= 100, {}
-
-
 def training_shares(steps: int, chunks: int) -> dict[str, Any]:
     """Train the thesis's DQN on each env, interleaved in chunks; seconds and env shares."""
-    import torch
-    from stable_baselines3 import DQN
-
-    class ChunkedDQN(DQN):
-        """Keeps the schedules (epsilon) of one ``steps``-step run across the chunks."""
-
-        def _update_current_progress_remaining(self, num_timesteps: int, total: int) -> None:
-            super()._update_current_progress_remaining(num_timesteps, steps)
-
-    torch.set_num_threads(1)
     cfg = load_experiment("config01").env_config()
     real = frontier_marl.FrontierExploreEnv(preset=None, config=cfg)
     unlabelled = MinimalStep()
@@ -298,39 +274,14 @@ def training_shares(steps: int, chunks: int) -> dict[str, Any]:
         "minimal": MinimalStep(),
         "minimal_without_labelling": unlabelled,
     }
-    models = {}
-    for name, env in envs.items():
-        env.reset(seed=0)  # loads the compiled kernels, outside the timing
-        models[name] = ChunkedDQN(
-            "MultiInputPolicy",
-            env,
-            learning_rate=5e-5,
-            exploration_fraction=0.7,
-            exploration_final_eps=0.05,
-            batch_size=64,
-            buffer_size=50_000,
-            target_update_interval=500,
-            train_freq=4,
-            learning_starts=1000,
-            seed=0,
-            verbose=0,
-        )
-    names = list(envs)
-    seconds = dict.fromkeys(names, 0.0)
-    per_chunk = -(-steps // chunks)
-    for chunk in range(chunks):
-        shift = chunk % len(names)
-        for name in names[shift:] + names[:shift]:
-            start = time.perf_counter()
-            models[name].learn(total_timesteps=per_chunk, reset_num_timesteps=chunk == 0)
-            seconds[name] += time.perf_counter() - start
+    seconds = {name: sum(chunk) for name, chunk in train_interleaved(envs, steps, chunks).items()}
     return {
-        "steps": models["env"].num_timesteps,
+        "steps": chunks * -(-steps // chunks),
         "chunks": chunks,
         "seconds": seconds,
         "env_share": {
             name: (seconds[name] - seconds["null"]) / seconds[name]
-            for name in names
+            for name in envs
             if name != "null"
         },
     }
