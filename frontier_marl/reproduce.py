@@ -2,7 +2,9 @@
 
 :func:`reproduce` trains ``training/config01.toml`` (thesis-20x20, static map, Reward 2) with
 :func:`frontier_marl.training.train.train`, whose final evaluation is the thesis protocol
-(deterministic, ``episodes`` episodes with reset seeds ``0 .. episodes-1``); runs the heuristic
+(deterministic, ``episodes`` episodes with reset seeds ``0 .. episodes-1``) of the final model
+and, with the config's validation, of the best-validated policy (the one the table reports,
+the final model beside it); runs the heuristic
 baselines on the same env and the same episodes with
 :func:`frontier_marl.commands.baselines.run_baselines`; and writes, under ``out``::
 
