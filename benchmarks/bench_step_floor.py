@@ -135,25 +135,7 @@ class MinimalStep(gym.Env):
             and target in history[:-1]
         )
         self.history = (*history, target)[-(reward_cfg.oscillation_window + 1) :]
-        offsets, between = world.params.sensor.rays
-        world._version = kernels.walk(
-            world._true,
-            world._belief,
-            world._seen,
-            world._positions,
-            world._travelled,
-            goals,
-            world._plan_cells,
-            world._plan_meta,
-            world._version,
-            world.params.cells_per_step,
-            offsets,
-            between,
-            world._new_cells,
-            world._walked,
-            world._walked_len,
-            world._reached,
-        )
+        world._walk()
         new = int(world._new_cells[0])
         self.steps += 1
         self.without_progress = 0 if new else self.without_progress + 1

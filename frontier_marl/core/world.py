@@ -344,6 +344,14 @@ class World:
         goals = self._goals
         for agent, target in enumerate(targets):
             goals[agent] = (-1, -1) if target is None else target
+        self._walk()
+        walked, lengths = self._walked, self._walked_len.tolist()
+        paths = [walked[agent, :length].copy() for agent, length in enumerate(lengths)]
+        return MoveResult(self._new_cells.copy(), paths, self._reached.copy())
+
+    def _walk(self) -> None:
+        """:func:`kernels.walk` toward ``self._goals`` (row -1: stay); its outputs are left in
+        ``_new_cells``, ``_walked``, ``_walked_len`` and ``_reached``."""
         offsets, between = self.params.sensor.rays
         self._version = kernels.walk(
             self._true,
@@ -351,7 +359,7 @@ class World:
             self._seen,
             self._positions,
             self._travelled,
-            goals,
+            self._goals,
             self._plan_cells,
             self._plan_meta,
             self._version,
@@ -363,9 +371,6 @@ class World:
             self._walked_len,
             self._reached,
         )
-        walked, lengths = self._walked, self._walked_len.tolist()
-        paths = [walked[agent, :length].copy() for agent, length in enumerate(lengths)]
-        return MoveResult(self._new_cells.copy(), paths, self._reached.copy())
 
     def _sense(self, agent: int, cell: tuple[int, int] | None = None) -> int:
         """Sense from robot ``agent``'s cell (given as ``cell`` when known); count new cells."""
