@@ -23,6 +23,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -384,7 +385,24 @@ def _fit(
             callbacks=callbacks,
         ),
     )
-    return tuner.fit()
+    return _restoring_signal_handlers(tuner.fit)
+
+
+def _restoring_signal_handlers(run: Any) -> Any:
+    """``run()``, then the SIGINT/SIGUSR1 handlers it found: Ray Tune's ``fit`` installs its
+    own and leaves them in place when the run ends normally, after which Ctrl-C no longer
+    raises ``KeyboardInterrupt`` anywhere in this process."""
+    import signal
+
+    names = [n for n in ("SIGINT", "SIGUSR1") if hasattr(signal, n)]
+    saved = {n: signal.getsignal(getattr(signal, n)) for n in names}
+    try:
+        return run()
+    finally:
+        if threading.current_thread() is threading.main_thread():
+            for name, handler in saved.items():
+                if handler is not None:
+                    signal.signal(getattr(signal, name), handler)
 
 
 def _progress_callback(tune: Any, trials: Sequence[TrialSpec], progress: bool) -> Any:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import json
+import signal
 import sys
 from pathlib import Path
 
@@ -107,7 +108,10 @@ def campaign(local_ray, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path,
         "1",
         "--no-progress",
     ]
+    handler = signal.getsignal(signal.SIGINT)
     assert main(args) == 0
+    # Ray Tune's fit installs its own SIGINT handler and leaves it; the campaign restores ours
+    assert signal.getsignal(signal.SIGINT) is handler
     return out, args
 
 
