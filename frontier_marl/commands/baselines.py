@@ -52,6 +52,31 @@ positive_int = int_at_least(1)
 non_negative_int = int_at_least(0)
 
 
+def int_list(low: int) -> Callable[[str], list[int]]:
+    """argparse type: comma-separated integers >= ``low`` (``1e6`` and ``1_000_000`` work)."""
+
+    def parse(text: str) -> list[int]:
+        values = []
+        for item in text.split(","):
+            item = item.strip().replace("_", "")
+            if not item:
+                continue
+            try:
+                value = int(float(item)) if "e" in item.lower() else int(item)
+            except ValueError:
+                raise argparse.ArgumentTypeError(
+                    f"expected comma-separated integers >= {low}, got {text!r}"
+                ) from None
+            if value < low:
+                raise argparse.ArgumentTypeError(f"expected integers >= {low}, got {value}")
+            values.append(value)
+        if not values:
+            raise argparse.ArgumentTypeError(f"expected at least one integer, got {text!r}")
+        return values
+
+    return parse
+
+
 def parse_value(text: str) -> Any:
     """A ``--set`` value: int, float, bool (true/false), None (none), else the string
     (e.g. ``full``, ``raycast``)."""

@@ -19,33 +19,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable
 from pathlib import Path
-
-
-def _int_list(low: int) -> Callable[[str], list[int]]:
-    """argparse type: comma-separated integers >= ``low`` (``1e6`` and ``1_000_000`` work)."""
-
-    def parse(text: str) -> list[int]:
-        values = []
-        for item in text.split(","):
-            item = item.strip().replace("_", "")
-            if not item:
-                continue
-            try:
-                value = int(float(item)) if "e" in item.lower() else int(item)
-            except ValueError:
-                raise argparse.ArgumentTypeError(
-                    f"expected comma-separated integers >= {low}, got {text!r}"
-                ) from None
-            if value < low:
-                raise argparse.ArgumentTypeError(f"expected integers >= {low}, got {value}")
-            values.append(value)
-        if not values:
-            raise argparse.ArgumentTypeError(f"expected at least one integer, got {text!r}")
-        return values
-
-    return parse
 
 
 def _positive_float(text: str) -> float:
@@ -59,7 +33,7 @@ def _positive_float(text: str) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.baselines import positive_int
+    from frontier_marl.commands.baselines import int_list, positive_int
 
     parser.add_argument(
         "--configs",
@@ -69,14 +43,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--seeds",
-        type=_int_list(0),
+        type=int_list(0),
         default=[0],
         metavar="S,S,...",
         help="training seeds (default: 0)",
     )
     parser.add_argument(
         "--steps",
-        type=_int_list(1),
+        type=int_list(1),
         default=[1_000_000],
         metavar="N,N,...",
         help="training budgets (default: 1000000)",
