@@ -22,6 +22,13 @@ from frontier_marl.reproduce import HEURISTICS, reproduce  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 STEPS, EPISODES = 2000, 3
+VALIDATED_CONFIG = (
+    'name = "config01"\n'
+    'description = "configuration 1 with validation"\n'
+    '[env]\npreset = "thesis-20x20"\ncentroid = "absolute"\nagent_position = true\n'
+    'info_gain = false\nsort_by_distance = false\nreward = "reward2"\n'
+    "[train]\nvalidate_every = 500\nvalidation_episodes = 2\n"
+)
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +101,8 @@ def test_reproduce_json_has_dqn_and_heuristic_rows_with_thesis_figures(
         assert rows[name]["kind"] == "heuristic"
         assert rows[name]["episodes"] == EPISODES
     assert table["training"]["steps"] == STEPS
-    assert table["training"]["seed"] == 1
+    assert table["training"]["seeds"] == [1]
+    assert [run["seed"] for run in table["training"]["runs"]] == [1]
     assert table["setting"]["map_mode"] == "static"
     assert table["setting"]["seeds"] == [0, EPISODES - 1]
     assert set(table["checks"]) == {
@@ -102,8 +110,10 @@ def test_reproduce_json_has_dqn_and_heuristic_rows_with_thesis_figures(
         "three_actions_above_2pct",
         "mean_at_least_13.1",
     }
-    assert table["summary"]["config"] == "config01"
-    assert table["summary"]["mean_reward"] == pytest.approx(dqn["mean_reward"])
+    [summary] = table["summaries"]
+    assert summary["config"] == "config01"
+    assert summary["mean_reward"] == pytest.approx(dqn["mean_reward"])
+    assert table["seed_spread"]["means"] == [pytest.approx(dqn["mean_reward"])]
 
 
 def test_heuristics_ran_on_the_dqn_evaluation_episodes(reproduced: tuple[Path, str]) -> None:
@@ -162,7 +172,14 @@ def test_reproduce_refuses_existing_run_then_resumes(
 
 @pytest.mark.parametrize(
     ("kwargs", "name"),
-    [({"steps": 0}, "steps"), ({"seed": -1}, "seed"), ({"episodes": 0}, "episodes")],
+    [
+        ({"steps": 0}, "steps"),
+        ({"seeds": [-1]}, "seeds"),
+        ({"seeds": []}, "seeds"),
+        ({"seeds": [0, 0]}, "distinct"),
+        ({"jobs": 0}, "jobs"),
+        ({"episodes": 0}, "episodes"),
+    ],
 )
 def test_reproduce_rejects_bad_input(kwargs: dict, name: str, tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=name):
@@ -186,16 +203,11 @@ def test_reproduce_reports_the_best_validated_policy_beside_the_final_model(
     tmp_path: Path,
 ) -> None:
     config = tmp_path / "validated.toml"
-    config.write_text(
-        'name = "config01"\n'
-        'description = "configuration 1 with validation"\n'
-        '[env]\npreset = "thesis-20x20"\ncentroid = "absolute"\nagent_position = true\n'
-        'info_gain = false\nsort_by_distance = false\nreward = "reward2"\n'
-        "[train]\nvalidate_every = 500\nvalidation_episodes = 2\n"
-    )
+    config.write_text(VALIDATED_CONFIG)
     result = reproduce(
         tmp_path / "out",
         steps=1000,
+        seeds=[0],
         episodes=2,
         config=config,
         heuristics=("greedy-distance",),
@@ -210,12 +222,115 @@ def test_reproduce_reports_the_best_validated_policy_beside_the_final_model(
         "DQN config01, final model",
         "greedy-distance",
     ]
-    best = json.loads((result.run_dir / "best" / "evaluation.json").read_text())
-    final = json.loads((result.run_dir / "evaluation.json").read_text())
+    [run_dir] = result.run_dirs
+    best = json.loads((run_dir / "best" / "evaluation.json").read_text())
+    final = json.loads((run_dir / "evaluation.json").read_text())
     assert rows[0]["mean_reward"] == best["model"]["mean_reward"]
     assert rows[1]["mean_reward"] == final["model"]["mean_reward"]
     assert rows[0]["thesis_mean"] == 15.55 and rows[1]["thesis_mean"] is None
     step = best["validation"]["step"]
-    assert table["training"]["reported_policy"].startswith(f"best-validated policy (step {step},")
-    assert table["summary"]["mean_reward"] == best["model"]["mean_reward"]
-    assert "best-validated policy" in (result.out / "comparison.md").read_text()
+    [run] = table["training"]["runs"]
+    assert run["reported_policy"].startswith(f"best-validated policy (step {step},")
+    assert table["summaries"][0]["mean_reward"] == best["model"]["mean_reward"]
+    assert f"best-validated policy (step {step}," in (result.out / "comparison.md").read_text()
+
+
+def test_reproduce_with_two_seeds_pools_them_and_reports_each(tmp_path: Path) -> None:
+    config = tmp_path / "validated.toml"
+    config.write_text(VALIDATED_CONFIG)
+    result = reproduce(
+        tmp_path / "out",
+        steps=1000,
+        seeds=[0, 1],
+        jobs=2,
+        episodes=2,
+        config=config,
+        heuristics=("greedy-distance",),
+        progress=False,
+        log=lambda _line: None,
+    )
+    table = result.table
+    assert table is not None and not result.interrupted
+    assert result.run_dirs == [
+        tmp_path / "out" / "config01_seed0",
+        tmp_path / "out" / "config01_seed1",
+    ]
+    best = [json.loads((d / "best" / "evaluation.json").read_text()) for d in result.run_dirs]
+    final = [json.loads((d / "evaluation.json").read_text()) for d in result.run_dirs]
+    rows = table["rows"]
+    steps = [b["validation"]["step"] for b in best]
+    assert [row["policy"] for row in rows] == [
+        "DQN config01",
+        f"DQN config01, seed 0 (step {steps[0]})",
+        f"DQN config01, seed 1 (step {steps[1]})",
+        "DQN config01, final models",
+        "greedy-distance",
+    ]
+    pooled, seed0, seed1, finals = rows[:4]
+    best_means = [b["model"]["mean_reward"] for b in best]
+    assert pooled["episodes"] == 4 and pooled["thesis_mean"] == 15.55
+    assert pooled["mean_reward"] == pytest.approx(sum(best_means) / 2)
+    assert pooled["terminations"] == sum(b["model"]["terminations"] for b in best)
+    assert pooled["degenerate"] == (seed0["degenerate"] or seed1["degenerate"])
+    assert [seed0["mean_reward"], seed1["mean_reward"]] == best_means
+    assert finals["mean_reward"] == pytest.approx(sum(f["model"]["mean_reward"] for f in final) / 2)
+    spread = table["seed_spread"]
+    assert spread["seeds"] == [0, 1] and spread["means"] == best_means
+    assert spread["std"] == pytest.approx(abs(best_means[0] - best_means[1]) / 2)
+    assert table["checks"]["mean_at_least_13.1"] == (pooled["mean_reward"] >= 13.1)
+    assert [run["seed"] for run in table["training"]["runs"]] == [0, 1]
+    assert [s["seed"] for s in table["summaries"]] == [0, 1]
+    markdown = (result.out / "comparison.md").read_text()
+    assert "Across seeds:" in markdown and "seeds 0, 1 (2 runs at a time)" in markdown
+    assert (result.out / "learning_curve.png").stat().st_size > 0
+
+
+GENUINE = {"action_shares": [0.5, 0.3, 0.15, 0.05]}
+DEGENERATE = {"action_shares": [0.95, 0.05, 0.0, 0.0]}
+
+
+def test_genuine_checks_ask_every_seed_to_be_genuine_and_the_mean_to_reach_the_bar() -> None:
+    from frontier_marl.reproduce import genuine_checks
+
+    assert genuine_checks([GENUINE, GENUINE], 13.1) == {
+        "max_share_at_most_70pct": True,
+        "three_actions_above_2pct": True,
+        "mean_at_least_13.1": True,
+    }
+    mixed = genuine_checks([GENUINE, DEGENERATE], 15.0)
+    assert not mixed["max_share_at_most_70pct"] and not mixed["three_actions_above_2pct"]
+    assert mixed["mean_at_least_13.1"]
+    assert not genuine_checks([GENUINE], 13.09)["mean_at_least_13.1"]
+
+
+def test_pool_evaluations_holds_every_run_s_episodes() -> None:
+    from frontier_marl.reproduce import pool_evaluations
+
+    a = {
+        "episodes": 2,
+        "rewards": [10.0, 12.0],
+        "terminations": 1,
+        "action_counts": [10, 0, 0, 0],
+        "action_shares": [1.0, 0.0, 0.0, 0.0],
+        "mean_travelled": 5.0,
+    }
+    b = {
+        "episodes": 2,
+        "rewards": [14.0, 16.0],
+        "terminations": 2,
+        "action_counts": [0, 2, 4, 4],
+        "action_shares": [0.0, 0.2, 0.4, 0.4],
+        "mean_travelled": 7.0,
+    }
+    pooled = pool_evaluations([a, b], "both")
+    assert pooled["policy"] == "both" and pooled["episodes"] == 4
+    assert pooled["rewards"] == [10.0, 12.0, 14.0, 16.0]
+    assert pooled["mean_reward"] == pytest.approx(13.0)
+    assert pooled["std_reward"] == pytest.approx(5.0**0.5)  # population std of the 4 episodes
+    assert pooled["terminations"] == 3
+    assert pooled["action_counts"] == [10, 2, 4, 4]
+    assert pooled["action_shares"] == pytest.approx([0.5, 0.1, 0.2, 0.2])
+    assert pooled["mean_travelled"] == pytest.approx(6.0)
+    # 50 % slot 0 overall, but run a alone is degenerate: the pooled row says so
+    assert pooled["degeneracy"]["degenerate"]
+    assert not pool_evaluations([b, b], "b twice")["degeneracy"]["degenerate"]

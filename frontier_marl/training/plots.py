@@ -80,28 +80,56 @@ def plot_learning_curve(
     ``rollout/ep_rew_mean``), TD loss (``train/loss``, log scale) and epsilon
     (``rollout/exploration_rate``). ``reference`` maps labels to horizontal reward lines;
     ``validation`` records (``step``, ``mean_reward``) add the greedy policy's scores."""
+    plot_learning_curves([("", metrics, validation)], path, title, reference)
+
+
+def plot_learning_curves(
+    runs: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]],
+    path: str | os.PathLike[str],
+    title: str | None = None,
+    reference: Mapping[str, float] | None = None,
+) -> None:
+    """:func:`plot_learning_curve` with several runs overlaid, one colour each: ``runs`` holds
+    (label, metrics rows, validation records) per run, e.g. one per seed."""
     plt = _pyplot()
     fig, (reward, loss, eps) = plt.subplots(1, 3, figsize=(13, 3.6))
     try:
-        steps, values = _series(metrics, "rollout/ep_rew_mean")
-        reward.plot(steps, values, color="C0", label="training episodes (epsilon-greedy)")
-        steps, values = _series(validation, "mean_reward")
-        if len(steps):
+        for i, (label, metrics, validation) in enumerate(runs):
+            colour = f"C{i}"
+            prefix = f"{label}: " if label else ""
+            steps, values = _series(metrics, "rollout/ep_rew_mean")
             reward.plot(
-                steps, values, color="C4", marker=".", linewidth=0.8, label="greedy, validation"
+                steps, values, color=colour, label=f"{prefix}training episodes (epsilon-greedy)"
             )
+            steps, values = _series(validation, "mean_reward")
+            if len(steps):
+                reward.plot(
+                    steps,
+                    values,
+                    color=colour,
+                    marker=".",
+                    linewidth=0.6,
+                    linestyle="--",
+                    label=f"{prefix}greedy, validation",
+                )
+            steps, values = _series(metrics, "train/loss")
+            loss.plot(steps, values, color=colour, linewidth=0.8, label=label or None)
+            steps, values = _series(metrics, "rollout/exploration_rate")
+            eps.plot(steps, values, color=colour)
+        styles = (":", "-.", (0, (5, 2)), (0, (1, 3)))
         for i, (label, value) in enumerate((reference or {}).items()):
-            reward.axhline(value, color=f"C{i + 1}", linestyle=":", linewidth=1, label=label)
-        if reference or len(steps):
-            reward.legend(fontsize=8, loc="lower right")
+            reward.axhline(
+                value, color="0.25", linestyle=styles[i % len(styles)], linewidth=1, label=label
+            )
+        if reward.lines and (reference or len(runs) > 1 or any(v for _l, _m, v in runs)):
+            reward.legend(fontsize=7, loc="lower right")
         reward.set_title("episode reward (rolling mean of 100)", fontsize=9)
-        steps, values = _series(metrics, "train/loss")
-        loss.plot(steps, values, color="C1", linewidth=0.8)
+        values = np.concatenate([_series(m, "train/loss")[1] for _l, m, _v in runs] or [[]])
         if len(values) and np.all(values > 0):
             loss.set_yscale("log")
+        if len(runs) > 1:
+            loss.legend(fontsize=7, loc="upper right")
         loss.set_title("TD loss (Huber)", fontsize=9)
-        steps, values = _series(metrics, "rollout/exploration_rate")
-        eps.plot(steps, values, color="C2")
         eps.set_ylim(0, 1.05)
         eps.set_title("epsilon", fontsize=9)
         for ax in (reward, loss, eps):
