@@ -105,3 +105,15 @@ def test_ctrl_c_stops_every_worker_with_a_checkpoint(tmp_path: Path) -> None:
 def test_workers_must_be_positive(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="workers"):
         train_runs(_jobs(tmp_path, [0]), workers=0)
+
+
+def test_a_failing_run_stops_the_others_and_raises_its_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    healthy = TrainJob(tiny(0, steps=100_000), tmp_path / "seed0", label="seed 0")
+    broken = TrainJob(tiny(1), blocker / "seed1", label="seed 1")  # its folder cannot exist
+    with pytest.raises(OSError):
+        train_runs([healthy, broken], workers=2, progress=False)
+    [checkpoint] = list_checkpoints(healthy.run_dir)  # stopped early, with a checkpoint
+    assert 0 < checkpoint.step < 100_000
+    assert (healthy.run_dir / "model.zip").is_file()

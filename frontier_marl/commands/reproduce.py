@@ -7,7 +7,7 @@ in worker processes; runs the heuristic baselines (greedy-distance, greedy-gain,
 random) on the same episodes; and prints and saves the comparison with the thesis's figures
 (SPEC section 6): the seeds' policies pooled, each seed, and the spread across seeds::
 
-    frontier-marl reproduce                              # 3 seeds x 1e6 steps, ~22 min on 2 cores
+    frontier-marl reproduce                              # 3 seeds x 1e6 steps, ~26 min on 2 cores
     frontier-marl reproduce --seed 0                     # one seed, ~14 min
     frontier-marl reproduce --steps 50000 --out runs/quick
     frontier-marl reproduce --resume                     # after Ctrl-C: continue the runs

@@ -8,7 +8,8 @@ one job the runs train in this process, one after the other.
 Ctrl-C stops every run cleanly: the worker processes ignore SIGINT themselves; the parent asks
 them, through a shared event, to end the session like Ctrl-C would (checkpoint and model
 saved, no evaluation; a run already in its final evaluation finishes it), and runs not yet
-started are skipped. ``--resume`` continues them.
+started are skipped. ``--resume`` continues them. When one run fails, the others are stopped
+the same way and its error is raised.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import queue
 import signal
 import sys
 from collections.abc import Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -123,6 +124,8 @@ def _train_in_workers(jobs: Sequence[TrainJob], workers: int, progress: bool) ->
             try:
                 if all(f.done() for f in futures):
                     break
+                if any(f.done() and f.exception() for f in futures):
+                    stop.set()  # one run failed: the others save a checkpoint and end
                 _drain(reports, bars, timeout=0.5)
             except KeyboardInterrupt:
                 stop.set()
@@ -135,16 +138,9 @@ def _train_in_workers(jobs: Sequence[TrainJob], workers: int, progress: bool) ->
                 interrupted = True
         _drain(reports, bars, timeout=0.0)
     bars.close()
-    results = [_result(f) for f in futures]
+    results = [f.result() for f in futures]  # a worker's error is raised here, as it was
     interrupted = interrupted or any(r is None or r.interrupted for r in results)
     return TrainOutcome(results, interrupted)
-
-
-def _result(future: Future) -> Any:
-    try:
-        return future.result()
-    except Exception as exc:  # a worker's error, e.g. a config SB3 rejects: say which run
-        raise RuntimeError(f"a training run failed in its worker process: {exc}") from exc
 
 
 def _drain(reports: Any, bars: _Bars, timeout: float) -> None:
