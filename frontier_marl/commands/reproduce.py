@@ -44,8 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int_list(0),
         default=list(DEFAULT_SEEDS),
         metavar="S,S,...",
-        help="training seeds, comma-separated (default: %(default)s); the table pools their "
-        "policies and gives each seed and the spread",
+        help=f"training seeds, comma-separated (default: {','.join(map(str, DEFAULT_SEEDS))}); "
+        "the table pools their policies and gives each seed and the spread",
     )
     parser.add_argument(
         "--jobs",
@@ -72,8 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--resume",
         action="store_true",
-        help="continue the run in --out from its newest checkpoint (after "
-        "Ctrl-C), or re-evaluate a finished one",
+        help="continue the runs in --out from their newest checkpoints (after "
+        "Ctrl-C), or re-evaluate finished ones",
     )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bars")
 
