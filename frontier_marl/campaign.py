@@ -23,6 +23,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import signal
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -392,8 +393,6 @@ def _restoring_signal_handlers(run: Any) -> Any:
     """``run()``, then the SIGINT/SIGUSR1 handlers it found: Ray Tune's ``fit`` installs its
     own and leaves them in place when the run ends normally, after which Ctrl-C no longer
     raises ``KeyboardInterrupt`` anywhere in this process."""
-    import signal
-
     names = [n for n in ("SIGINT", "SIGUSR1") if hasattr(signal, n)]
     saved = {n: signal.getsignal(getattr(signal, n)) for n in names}
     try:
