@@ -11,6 +11,7 @@ import contextlib
 import hashlib
 import io
 import json
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -49,7 +50,7 @@ def _strip_config(value: Any) -> Any:
 
 
 def run(name: str) -> dict[str, Any]:
-    """The command's table (its printed lines, file paths left out) and its JSON digest."""
+    """The command's table (its printed lines, file paths replaced by ``<path>``) and its JSON digest."""
     from frontier_marl.cli import main
 
     with tempfile.TemporaryDirectory() as folder:
@@ -60,7 +61,7 @@ def run(name: str) -> dict[str, Any]:
         if code != 0:
             raise RuntimeError(f"{name} exited with {code}")
         rows = _strip_config(json.loads(out.read_text()))
-    lines = [line for line in printed.getvalue().splitlines() if "/" not in line.split(" ")[0]]
+    lines = [re.sub(r"(^|\s)/\S+", r"\1<path>", line) for line in printed.getvalue().splitlines()]
     canonical = json.dumps(rows, sort_keys=True).encode()
     return {"table": lines, "json_sha256": hashlib.sha256(canonical).hexdigest()}
 
