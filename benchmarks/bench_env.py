@@ -3,7 +3,6 @@
     python benchmarks/bench_env.py                 # everything, ~3 minutes on 2 cores
     python benchmarks/bench_env.py --skip-dqn      # decisions per second only
     python benchmarks/bench_env.py --json out.json
-    python benchmarks/bench_env.py --reference     # also time the numpy path (no numba kernels)
 
 Reports decisions per second (one decision = one ``step`` of all robots) for a random-valid-slot
 policy and a nearest-cluster policy on the thesis presets and larger maps, and the share of SB3
@@ -16,11 +15,9 @@ env and on a null env with identical spaces, in one run (interleaved in chunks),
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import platform
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +25,6 @@ import gymnasium as gym
 import numpy as np
 
 import frontier_marl
-from frontier_marl.core import kernels
 
 SETTINGS: list[tuple[str, dict[str, Any]]] = [
     ("thesis-20x20, 1 robot", {"preset": "thesis-20x20"}),
@@ -81,17 +77,6 @@ def nearest(info: dict[str, Any], rng: np.random.Generator) -> int:
 
 def random_valid(info: dict[str, Any], rng: np.random.Generator) -> int:
     return int(rng.choice(np.flatnonzero(info["action_mask"])))
-
-
-@contextlib.contextmanager
-def compiled_kernels(enabled: bool) -> Iterator[None]:
-    """Run the block with the compiled kernels on or off."""
-    saved = kernels.ENABLED
-    kernels.ENABLED = enabled
-    try:
-        yield
-    finally:
-        kernels.ENABLED = saved
 
 
 def decisions_per_second(kwargs: dict[str, Any], policy: Any, seconds: float) -> dict[str, float]:
@@ -221,11 +206,6 @@ def main() -> None:
         "--dqn-chunks", type=int, default=15, help="alternating chunks of the two DQN runs"
     )
     parser.add_argument("--skip-dqn", action="store_true")
-    parser.add_argument(
-        "--reference",
-        action="store_true",
-        help="also time the numpy reference path (kernels off) in the same run",
-    )
     parser.add_argument("--json", help="write the figures to this file")
     parser.add_argument(
         "--explore-bench-map",
@@ -242,42 +222,24 @@ def main() -> None:
         "python": platform.python_version(),
         "decisions": [],
     }
-    modes = ["kernels" if kernels.ENABLED else "numpy"]
-    if args.reference and kernels.ENABLED:
-        modes.append("numpy")
-    report["modes"] = modes
-    print(f"compiled kernels: {'on' if kernels.ENABLED else 'off (numba missing or disabled)'}")
-    print(
-        f"{'setting':<24}{'policy':<10}{'mode':<9}{'decisions/s':>12}{'us/decision':>13}"
-        f"{'time vs kernels':>17}"
-    )
+    print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
     for label, kwargs in settings:
         for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
-            first = None
-            for mode in modes:
-                with compiled_kernels(mode == "kernels"):
-                    row = decisions_per_second(kwargs, policy, args.seconds)
-                report["decisions"].append(
-                    {"setting": label, "policy": policy_name, "mode": mode, **row}
-                )
-                first = first or row
-                ratio = first["decisions_per_s"] / row["decisions_per_s"]
-                print(
-                    f"{label:<24}{policy_name:<10}{mode:<9}{row['decisions_per_s']:>12.0f}"
-                    f"{row['us_per_decision']:>13.1f}{ratio:>16.2f}x"
-                )
-    if not args.skip_dqn:
-        report["dqn"] = []
-        for mode in modes:
-            with compiled_kernels(mode == "kernels"):
-                dqn = dqn_env_share(args.dqn_steps, args.dqn_chunks)
-            report["dqn"].append({"mode": mode, **dqn})
+            row = decisions_per_second(kwargs, policy, args.seconds)
+            report["decisions"].append({"setting": label, "policy": policy_name, **row})
             print(
-                f"DQN {dqn['steps']} steps ({mode}): null env {dqn['seconds_null']:.1f} s, "
-                f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
-                f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} % "
-                f"(standard error over the chunks {100 * dqn['env_share_standard_error']:.1f})"
+                f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
+                f"{row['us_per_decision']:>13.1f}"
             )
+    if not args.skip_dqn:
+        dqn = dqn_env_share(args.dqn_steps, args.dqn_chunks)
+        report["dqn"] = dqn
+        print(
+            f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
+            f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
+            f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} % "
+            f"(standard error over the chunks {100 * dqn['env_share_standard_error']:.1f})"
+        )
     if args.json:
         with open(args.json, "w") as handle:
             json.dump(report, handle, indent=2)

@@ -30,7 +30,9 @@ import numpy as np
 from scipy import ndimage
 
 import frontier_marl
-from frontier_marl.core import kernels
+from frontier_marl.core.frontiers import clusters_from_labels, frontier_cells
+from frontier_marl.core.slots import _robot_slots
+from frontier_marl.core.world import count_known
 from frontier_marl.engine import StepInfo
 from frontier_marl.training.experiment import load_experiment
 
@@ -83,10 +85,10 @@ class MinimalStep(gym.Env):
     def _refresh(self) -> None:
         world = self.world
         if world._version != self._labelled_version:
-            mask, rows, cols = kernels.frontier_cells(world._belief)
+            mask, rows, cols = frontier_cells(world._belief)
             if len(rows):
                 image, count = self._label(mask)
-                cluster, sizes, centroids = kernels.clusters_from_labels(
+                cluster, sizes, centroids = clusters_from_labels(
                     image, rows, cols, count, self.cfg.max_cluster_cells
                 )
             else:
@@ -96,7 +98,7 @@ class MinimalStep(gym.Env):
             self._labelled_version = world._version
         rows, cols, cluster, centroids, sizes, gains = self._clusters
         position = world._positions[0]
-        self.slots = kernels.robot_slots(
+        self.slots = _robot_slots(
             world._belief,
             position[0],
             position[1],
@@ -140,7 +142,7 @@ class MinimalStep(gym.Env):
         self.steps += 1
         self.without_progress = 0 if new else self.without_progress + 1
         self._refresh()
-        known = kernels.count_known(world._belief, world._start_region)
+        known = count_known(world._belief, world._start_region)
         fraction = known / max(world._start_region_size, 1)
         reward = reward_cfg.cell_reward * new
         if new == 0:
@@ -162,7 +164,7 @@ class MinimalStep(gym.Env):
             if self.steps >= reward_cfg.max_steps:
                 reward += reward_cfg.step_limit_penalty
                 truncated = True
-        cluster, valid, centroid, target_cells, distance, size, gain = self.slots
+        cluster, valid, centroid, target_cells, distance, size, gain, _ = self.slots
         live = self.live
         features = np.zeros((self.n_slots, 2))
         features[:live] = centroid[:live]

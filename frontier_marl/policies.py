@@ -67,7 +67,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.core.grid import FREE
-from frontier_marl.core.planning import bfs_distances
+from frontier_marl.core.planning import distance_field, distance_fields
 
 Info = Mapping[str, Any]
 
@@ -200,7 +200,7 @@ class CostUtility(HeuristicPolicy):
             return {}
         belief = self._belief(info)
         row, col = (int(v) for v in info["position"])
-        distances = bfs_distances(belief == FREE, (row, col))
+        distances = distance_field(belief, FREE, row, col)
         lengths = {}
         for c in clusters:
             t_row, t_col = (int(v) for v in c["target"])
@@ -256,28 +256,6 @@ class RandomValid(HeuristicPolicy):
         return int(valid[self._rng.integers(len(valid))])
 
 
-def path_length_fields(passable: np.ndarray, sources: Sequence[tuple[int, int]]) -> np.ndarray:
-    """(len(sources), H, W) 4-connected shortest path lengths from each source over the
-    ``passable`` cells; -1 where unreachable (the same numbers as BFS / A*, computed in C)."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra
-
-    passable = np.asarray(passable, dtype=bool)
-    height, width = passable.shape
-    index = np.arange(height * width).reshape(height, width)
-    across = passable[:, :-1] & passable[:, 1:]
-    down = passable[:-1, :] & passable[1:, :]
-    rows = np.concatenate([index[:, :-1][across], index[:-1, :][down]])
-    cols = np.concatenate([index[:, 1:][across], index[1:, :][down]])
-    graph = csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(height * width, height * width))
-    starts = [int(r) * width + int(c) for r, c in sources]
-    if not starts:
-        return np.zeros((0, height, width), dtype=np.int64)
-    dist = dijkstra(graph, directed=False, indices=starts, unweighted=True)
-    dist = np.atleast_2d(dist)
-    return np.where(np.isfinite(dist), dist, -1).astype(np.int64).reshape(-1, height, width)
-
-
 class _Option:
     """One (robot, cluster) pair a joint heuristic may choose."""
 
@@ -330,7 +308,7 @@ class TeamHeuristic(Policy):
             return [[] for _ in infos]
         belief = self._belief(infos)
         positions = [tuple(int(v) for v in info["position"]) for info in infos]
-        fields = path_length_fields(belief == FREE, positions)
+        fields = distance_fields(belief == FREE, positions)
         out = []
         for agent, clusters in enumerate(per_agent):
             mine = []

@@ -10,13 +10,13 @@ from scipy import ndimage
 
 from frontier_marl.core.frontiers import (
     cluster_frontiers,
-    free_components,
     frontier_mask,
-    nearest_cells_to_centroids,
     split_cells,
     unknown_around,
 )
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
+from frontier_marl.core.slots import nearest_targets
+from tests import oracles
 
 _CODES = {"?": UNKNOWN, ".": FREE, "#": OCCUPIED}
 
@@ -262,6 +262,16 @@ def test_unknown_around_at_grid_border():
 
 
 # ----------------------------------------------------------------------------- targets
+def nearest_cells_to_centroids(clusters, eligible):
+    return nearest_targets(
+        clusters.cell_rows,
+        clusters.cell_cols,
+        clusters.cell_cluster,
+        clusters.centroids,
+        np.asarray(eligible, dtype=bool),
+    )
+
+
 def test_nearest_cell_to_centroid_8_connectivity():
     clusters = cluster_frontiers(STAIR, connectivity=8)  # centroid (1.8, 3.0)
     eligible = np.ones(5, dtype=bool)
@@ -303,40 +313,7 @@ def test_nearest_cell_none_eligible():
     np.testing.assert_array_equal(targets, np.full((4, 2), -1))
 
 
-# ----------------------------------------------------------------------------- components
-def test_free_components_are_4_connected_non_square():
-    belief = belief_from(
-        """
-        . # . ? .
-        # . # # .
-        . . # . .
-        """
-    )
-    expected = np.array(
-        [
-            [1, 0, 2, 0, 3],
-            [0, 4, 0, 0, 3],
-            [4, 4, 0, 3, 3],
-        ]
-    )
-    np.testing.assert_array_equal(free_components(belief), expected)
-
-
 # ----------------------------------------------------------------------------- properties
-def _naive_frontier(belief: np.ndarray) -> np.ndarray:
-    height, width = belief.shape
-    out = np.zeros(belief.shape, dtype=bool)
-    for r in range(height):
-        for c in range(width):
-            if belief[r, c] != FREE:
-                continue
-            for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-                rr, cc = r + dr, c + dc
-                if 0 <= rr < height and 0 <= cc < width and belief[rr, cc] == UNKNOWN:
-                    out[r, c] = True
-    return out
-
-
 def _naive_unknown_around(belief: np.ndarray, cells: np.ndarray) -> int:
     height, width = belief.shape
     found = set()
@@ -364,7 +341,7 @@ beliefs = st.tuples(
 @given(belief=beliefs, connectivity=st.sampled_from([4, 8]), max_cells=st.integers(0, 6))
 def test_cluster_properties_on_random_beliefs(belief, connectivity, max_cells):
     mask = frontier_mask(belief)
-    np.testing.assert_array_equal(mask, _naive_frontier(belief))
+    assert set(zip(*np.nonzero(mask), strict=True)) == oracles.frontier_set(belief)
     clusters = cluster_frontiers(belief, connectivity=connectivity, max_cells=max_cells)
     # Every frontier cell appears exactly once, in raster order.
     flat = clusters.cell_rows * belief.shape[1] + clusters.cell_cols
@@ -420,6 +397,8 @@ def test_split_cells_properties(n, max_cells, seed):
     flat = np.sort(rng.choice(15 * 15, size=n, replace=False))
     rows, cols = np.divmod(flat, 15)
     pieces = split_cells(rows, cols, max_cells)
+    cells = list(zip(rows.tolist(), cols.tolist(), strict=True))
+    assert [p.tolist() for p in pieces] == oracles.split(cells, max_cells)
     joined = np.sort(np.concatenate(pieces))
     np.testing.assert_array_equal(joined, np.arange(n))  # a partition of the indices
     assert all(1 <= len(p) <= max_cells for p in pieces)

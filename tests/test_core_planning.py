@@ -1,11 +1,17 @@
-"""Tests for frontier_marl.core.planning: A* on hand-made maps, and A* == BFS on random maps."""
+"""Tests for frontier_marl.core.planning: A* and distance fields on hand-made maps, and both
+against a plain BFS oracle on random maps."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from frontier_marl.core.planning import astar, bfs_distances
+from frontier_marl.core.planning import astar, distance_field, distance_fields
+from tests import oracles
+
+
+def bfs_distances(passable, start):
+    return distance_field(np.asarray(passable, dtype=bool), True, int(start[0]), int(start[1]))
 
 
 def passable_from(text: str) -> np.ndarray:
@@ -131,8 +137,8 @@ def test_bfs_distances_unreachable_region():
     np.testing.assert_array_equal(dist, expected)
 
 
-def test_astar_length_equals_bfs_on_random_maps():
-    """A* is optimal: on 300 random maps its path length equals the BFS distance."""
+def test_astar_and_distance_fields_equal_the_bfs_oracle_on_random_maps():
+    """On 300 random maps A*'s path length and the distance field both equal a plain BFS."""
     rng = np.random.default_rng(20240607)
     reachable_pairs = 0
     for trial in range(300):
@@ -143,7 +149,8 @@ def test_astar_length_equals_bfs_on_random_maps():
         if len(free) == 0:
             continue
         start = tuple(int(v) for v in free[rng.integers(len(free))])
-        dist = bfs_distances(passable, start)
+        dist = oracles.bfs(passable, start)
+        np.testing.assert_array_equal(bfs_distances(passable, start), dist)
         for _ in range(3):
             # Goals mostly on free cells, sometimes anywhere (blocked goals must give None).
             if rng.random() < 0.8:
@@ -173,3 +180,17 @@ def test_bfs_distances_match_astar_from_every_cell_small_map():
             assert (path is None) == (dist[goal] < 0)
             if path is not None:
                 assert len(path) - 1 == dist[goal]
+
+
+def test_distance_fields_stack_one_field_per_source():
+    sources = [(0, 0), (2, 5), (3, 0)]
+    fields = distance_fields(MAZE, sources)
+    assert fields.shape == (3, *MAZE.shape)
+    for field, source in zip(fields, sources, strict=True):
+        np.testing.assert_array_equal(field, oracles.bfs(MAZE, source))
+    assert distance_fields(MAZE, []).shape == (0, *MAZE.shape)
+
+
+def test_distance_field_on_a_belief_uses_free_cells_only():
+    belief = np.array([[0, 0, -1, 0], [1, 0, 0, 0]], dtype=np.int8)
+    np.testing.assert_array_equal(distance_field(belief, 0, 0, 0), [[0, 1, -1, 5], [-1, 2, 3, 4]])

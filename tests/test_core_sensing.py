@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN, new_belief
 from frontier_marl.core.sensing import RaycastSensor, SquareSensor, make_sensor
+from tests import oracles
 
 
 def grid_from(text: str) -> np.ndarray:
@@ -129,9 +130,7 @@ def test_raycast_wall_blocks_cells_behind_it():
 
 def test_raycast_same_cells_visible_without_the_wall():
     open_grid = np.zeros(WALL.shape, dtype=bool)
-    rows, cols = RaycastSensor(4).visible_cells(open_grid, (2, 0))
-    visible = np.zeros(WALL.shape, dtype=bool)
-    visible[rows, cols] = True
+    visible = RaycastSensor(4).visible(open_grid, (2, 0))
     expected = np.zeros(WALL.shape, dtype=bool)
     for r in range(5):
         for c in range(7):
@@ -160,9 +159,7 @@ def test_raycast_disc_only_at_corner_of_non_square_map():
 
 def test_raycast_disc_in_open_field():
     true_grid = np.zeros((7, 9), dtype=bool)
-    rows, cols = RaycastSensor(2).visible_cells(true_grid, (3, 4))
-    visible = np.zeros(true_grid.shape, dtype=bool)
-    visible[rows, cols] = True
+    visible = RaycastSensor(2).visible(true_grid, (3, 4))
     expected = np.zeros(true_grid.shape, dtype=bool)
     expected[2:5, 3:6] = True  # the 3x3 block (|dr|, |dc| <= 1)
     expected[[1, 5, 3, 3], [4, 4, 2, 6]] = True  # (+-2, 0) and (0, +-2); (1, 2) is outside
@@ -198,7 +195,7 @@ def test_raycast_four_neighbours_always_seen_behind_diagonal_walls():
         # . #
         """
     )
-    rows, cols = RaycastSensor(1).visible_cells(true_grid, (1, 1))
+    rows, cols = np.nonzero(RaycastSensor(1).visible(true_grid, (1, 1)))
     assert {(int(r), int(c)) for r, c in zip(rows, cols, strict=True)} == {
         (0, 1),
         (1, 0),
@@ -223,9 +220,10 @@ def test_sensor_properties(height, width, density, radius, seed):
     row, col = int(rng.integers(height)), int(rng.integers(width))
     true_grid[row, col] = False
     square, ray = SquareSensor(radius), RaycastSensor(radius)
-    rows, cols = ray.visible_cells(true_grid, (row, col))
-    visible = np.zeros(true_grid.shape, dtype=bool)
-    visible[rows, cols] = True
+    visible = ray.visible(true_grid, (row, col))
+    for model, sensor in (("square", square), ("raycast", ray)):
+        expected = oracles.visible(true_grid, (row, col), radius, model)
+        assert set(zip(*np.nonzero(sensor.visible(true_grid, (row, col))), strict=True)) == expected
     r_idx, c_idx = np.indices(true_grid.shape)
     disc = (r_idx - row) ** 2 + (c_idx - col) ** 2 <= radius * radius
     chebyshev = np.maximum(abs(r_idx - row), abs(c_idx - col))
@@ -234,8 +232,7 @@ def test_sensor_properties(height, width, density, radius, seed):
     assert visible[manhattan <= 1].all()  # the robot's cell and its 4-neighbours
     assert visible[(chebyshev <= 1) & disc].all()  # and its diagonals once inside the disc
     # With no obstacle the whole clipped disc is visible.
-    rows0, cols0 = ray.visible_cells(np.zeros_like(true_grid), (row, col))
-    assert len(rows0) == disc.sum()
+    assert ray.visible(np.zeros_like(true_grid), (row, col)).sum() == disc.sum()
     # Both sensors write the truth, count the new cells, and fill ``seen``.
     for sensor, expected_seen in ((square, chebyshev <= radius), (ray, visible)):
         belief = new_belief(true_grid.shape)
@@ -253,20 +250,3 @@ def test_make_sensor():
     assert isinstance(ray, RaycastSensor) and ray.range == 2
     with pytest.raises(ValueError, match="sensor"):
         make_sensor("lidar", 3)
-
-
-def test_raycast_cache_on_a_read_only_grid_matches_the_cast():
-    rng = np.random.default_rng(7)
-    grid = rng.random((9, 13)) < 0.3
-    frozen = grid.copy()
-    frozen.setflags(write=False)
-    sensor = RaycastSensor(4)
-    for row in range(9):
-        for col in range(13):
-            expected = sensor.visible_cells(grid, (row, col))  # writeable: never cached
-            first = sensor.visible_cells(frozen, (row, col))
-            again = sensor.visible_cells(frozen, (row, col))  # from the cache
-            for got in (first, again):
-                np.testing.assert_array_equal(got[0], expected[0])
-                np.testing.assert_array_equal(got[1], expected[1])
-    assert len(sensor._cache) == 9 * 13

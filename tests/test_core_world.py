@@ -11,9 +11,9 @@ from scipy import ndimage
 from frontier_marl.core.frontiers import frontier_mask
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import random_obstacle_map, sample_start_cells
-from frontier_marl.core.planning import bfs_distances
 from frontier_marl.core.sensing import RaycastSensor, SquareSensor
 from frontier_marl.core.world import FULL_PATH, World, WorldParams
+from tests import oracles
 
 
 def grid_from(text: str) -> np.ndarray:
@@ -254,6 +254,8 @@ def test_slots_of_a_corridor_robot():
     np.testing.assert_array_equal(slots.target, [[1, 2], [1, 4], [-1, -1]])
     np.testing.assert_allclose(slots.distance, [1.0, 1.0, 0.0])
     np.testing.assert_array_equal(slots.size, [1, 1, 0])
+    np.testing.assert_array_equal(slots.path_length, [1, 1, -1])
+    np.testing.assert_array_equal(slots.mask, [1, 1, 0])
     assert slots.live == 2
 
 
@@ -263,6 +265,7 @@ def test_slots_when_the_map_is_fully_explored():
     slots = world.slots(0, n_slots=3, sort_by_distance=True)
     assert slots.live == 0
     np.testing.assert_array_equal(slots.cluster, [-1, -1, -1])
+    np.testing.assert_array_equal(slots.mask, [1, 0, 0])  # slot 0 is the idle action
 
 
 # ----------------------------------------------------------------------------- properties
@@ -273,6 +276,7 @@ def _check_frontiers(world: World, max_cluster_cells: int, connectivity: int) ->
     near_unknown = unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2] | unknown[1:-1, 2:]
     definition = (belief == FREE) & near_unknown
     np.testing.assert_array_equal(frontier_mask(belief), definition)
+    assert set(zip(*np.nonzero(definition), strict=True)) == oracles.frontier_set(belief)
     clusters = world.clusters()
     labels = clusters.labels()
     np.testing.assert_array_equal(labels > 0, definition)  # clusters cover exactly the frontier
@@ -308,6 +312,30 @@ def _check_state(world: World, previous_known: np.ndarray) -> np.ndarray:
     for agent, (row, col) in enumerate(positions.tolist()):
         assert seen[agent, row, col]
     return known
+
+
+def _check_slots(world: World, slots, clusters, agent: int, n_slots: int) -> None:
+    """The slot rules of frontier_marl.core.slots, checked with a BFS oracle."""
+    position = tuple(int(v) for v in world.positions[agent])
+    dist = oracles.bfs(world.belief == FREE, position)
+    reachable = []  # (distance to centroid, cluster, target) of every reachable cluster
+    for k in range(clusters.count):
+        cells = [tuple(c) for c in clusters.cells_of(k).tolist() if dist[tuple(c)] >= 0]
+        if cells:
+            centroid = clusters.centroids[k]
+            target = min(cells, key=lambda c: (c[0] - centroid[0]) ** 2 + (c[1] - centroid[1]) ** 2)
+            reachable.append((float(np.hypot(*(centroid - position))), k, target))
+    chosen = sorted(sorted(reachable)[:n_slots], key=lambda entry: entry[1])
+    live = slots.live
+    assert live == slots.valid.sum() == len(chosen) <= n_slots
+    shown = {int(slots.cluster[i]): i for i in range(live)}
+    assert sorted(shown) == [k for _, k, _ in chosen]
+    for distance, k, target in chosen:
+        slot = shown[k]
+        assert tuple(slots.target[slot]) == target
+        assert slots.path_length[slot] == dist[target]
+        assert slots.distance[slot] == pytest.approx(distance)
+    assert (slots.cluster[live:] == -1).all() and (slots.path_length[live:] == -1).all()
 
 
 @settings(max_examples=60)
@@ -353,20 +381,14 @@ def test_world_invariants_under_random_play(
         targets: list[tuple[int, int] | None] = []
         for agent in range(n_agents):
             slots = world.slots(agent, n_slots=4, sort_by_distance=bool(rng.integers(2)))
-            assert slots.live == slots.valid.sum() <= 4
-            dist = bfs_distances(passable, tuple(world.positions[agent]))
-            for slot in np.flatnonzero(slots.valid):
-                row, col = slots.target[slot]
-                cluster_cells = clusters.cells_of(int(slots.cluster[slot]))
-                assert any((cluster_cells == (row, col)).all(axis=1))  # a cell of its cluster
-                assert world.belief[row, col] == FREE  # known free
-                assert dist[row, col] >= 0  # reachable through known-free cells
+            _check_slots(world, slots, clusters, agent, n_slots=4)
             live = np.flatnonzero(slots.valid)
             if len(live) and rng.random() < 0.9:
                 targets.append(tuple(int(v) for v in slots.target[rng.choice(live)]))
             else:
                 targets.append(None)
         before = world.positions.copy()
+        to_target = [None if t is None else oracles.bfs(passable, t) for t in targets]
         known_before = int(np.count_nonzero(world.belief != UNKNOWN))
         result = world.move(targets)
         # Paths start where the robot stood, move between 4-adjacent cells, end where it stands.
@@ -380,6 +402,9 @@ def test_world_invariants_under_random_play(
             if targets[agent] is None:
                 assert len(path) == 1
             assert result.reached[agent] == (len(path) > 1 and tuple(path[-1]) == targets[agent])
+            if to_target[agent] is not None:  # every move follows a shortest known-free path
+                remaining = to_target[agent][path[:, 0], path[:, 1]]
+                np.testing.assert_array_equal(remaining, remaining[0] - np.arange(len(path)))
         np.testing.assert_array_equal(
             world.travelled - travelled, [len(p) - 1 for p in result.paths]
         )

@@ -21,7 +21,6 @@ import frontier_marl
 from frontier_marl.cli import main
 from frontier_marl.config import make_config
 from frontier_marl.core.grid import FREE, OCCUPIED
-from frontier_marl.core.planning import bfs_distances
 from frontier_marl.evaluation import evaluate
 from frontier_marl.example_maps import example_map_path
 from frontier_marl.metrics import makespan_curve, overlap_ratio
@@ -30,9 +29,9 @@ from frontier_marl.policies import (
     CoordinatedAssignment,
     UtilityDiscount,
     make_policy,
-    path_length_fields,
 )
 from frontier_marl.rewards import StepEvents, step_outcome
+from tests.oracles import bfs as bfs_distances
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -466,14 +465,6 @@ def test_team_heuristics_need_a_map_and_a_range():
         UtilityDiscount(beta=-1.0)
     with pytest.raises(ValueError, match="sensor_range"):
         UtilityDiscount(sensor_range=0)
-
-
-def test_path_length_fields_match_bfs():
-    grid = ~frontier_marl.core.maps.rooms_map(20, 30, np.random.default_rng(1))
-    sources = [tuple(c) for c in np.argwhere(grid)[[0, 40, 90]].tolist()]
-    fields = path_length_fields(grid, sources)
-    for field, source in zip(fields, sources, strict=True):
-        assert np.array_equal(field, bfs_distances(grid, source))
 
 
 # ----------------------------------------------------------------- team metrics

@@ -1,13 +1,11 @@
-"""Frontier detection, clustering with ``scipy.ndimage.label``, splitting, and cluster statistics.
+"""Frontier detection, clustering with ``scipy.ndimage.label``, splitting, cluster statistics.
 
 A *frontier cell* is a known-free cell with at least one unknown 4-neighbour. Frontier cells
-are grouped into clusters of contiguous cells (4- or 8-connectivity); a cluster with more than
-``max_cells`` cells is split recursively in two across the longer side of its bounding box
-(at the box's midpoint) until every piece is small enough. Clusters are numbered in raster
-order of their first cell, the same convention as ``scipy.ndimage.label``.
-
-With numba (see :mod:`frontier_marl.core.kernels`) the loops around the labelling run compiled,
-with identical results; the labelling is ``scipy.ndimage.label`` in both modes.
+are grouped into clusters of contiguous cells (4- or 8-connectivity) by ``scipy.ndimage.label``;
+a cluster with more than ``max_cells`` cells is split recursively in two across the longer side
+of its bounding box (rows on a tie), at the box's midpoint, until every piece is small enough.
+Clusters are numbered in raster order of their first cell, the convention of
+``scipy.ndimage.label``.
 """
 
 from __future__ import annotations
@@ -17,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from frontier_marl.core import kernels
+from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import FREE, UNKNOWN
 
 _STRUCTURES = {
@@ -25,17 +23,6 @@ _STRUCTURES = {
     8: ndimage.generate_binary_structure(2, 2),
 }
 _EIGHT_OFFSETS = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0)]
-
-
-def frontier_mask(belief: np.ndarray) -> np.ndarray:
-    """Bool mask of frontier cells: known-free cells with an unknown 4-neighbour."""
-    unknown = belief == UNKNOWN
-    near_unknown = np.zeros_like(unknown)
-    near_unknown[1:, :] |= unknown[:-1, :]
-    near_unknown[:-1, :] |= unknown[1:, :]
-    near_unknown[:, 1:] |= unknown[:, :-1]
-    near_unknown[:, :-1] |= unknown[:, 1:]
-    return (belief == FREE) & near_unknown
 
 
 @dataclass(frozen=True)
@@ -73,6 +60,11 @@ class Clusters:
         return np.stack([self.cell_rows[pick], self.cell_cols[pick]], axis=1)
 
 
+def frontier_mask(belief: np.ndarray) -> np.ndarray:
+    """Bool mask of frontier cells: known-free cells with an unknown 4-neighbour."""
+    return frontier_cells(belief)[0]
+
+
 def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int = 0) -> Clusters:
     """Find, label and split the frontier clusters of ``belief``.
 
@@ -83,81 +75,26 @@ def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int 
     """
     if connectivity not in _STRUCTURES:
         raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
-    if kernels.ENABLED:
-        mask, rows, cols = kernels.frontier_cells(belief)
-    else:
-        mask = frontier_mask(belief)
-        rows, cols = np.divmod(np.flatnonzero(mask), belief.shape[1])
+    mask, rows, cols = frontier_cells(belief)
     if rows.size == 0:
         empty = np.zeros(0, dtype=np.int64)
         return Clusters(belief.shape, empty, empty, empty, empty, np.zeros((0, 2)))
     image, count = ndimage.label(mask, structure=_STRUCTURES[connectivity])
-    if kernels.ENABLED:
-        cluster, sizes, centroids = kernels.clusters_from_labels(
-            image, rows, cols, count, max_cells
-        )
-        return Clusters(belief.shape, rows, cols, cluster, sizes, centroids)
-    # ndimage numbers features in raster order of their first cell, so label - 1 is already
-    # the cluster index unless splitting adds pieces.
-    cluster = image[rows, cols].astype(np.int64) - 1
-    if max_cells > 0:
-        cluster = _split_oversized(rows, cols, cluster, count, max_cells)
-    sizes = np.bincount(cluster)
-    centroids = np.empty((len(sizes), 2))
-    centroids[:, 0] = np.bincount(cluster, weights=rows) / sizes
-    centroids[:, 1] = np.bincount(cluster, weights=cols) / sizes
+    cluster, sizes, centroids = clusters_from_labels(image, rows, cols, count, max_cells)
     return Clusters(belief.shape, rows, cols, cluster, sizes, centroids)
 
 
-def _split_oversized(
-    rows: np.ndarray, cols: np.ndarray, label: np.ndarray, count: int, max_cells: int
-) -> np.ndarray:
-    """Split clusters above ``max_cells`` and renumber all pieces in raster order."""
-    sizes = np.bincount(label, minlength=count)
-    oversized = np.flatnonzero(sizes > max_cells)
-    if oversized.size == 0:
-        return label
-    label = label.copy()
-    next_label = count
-    for cluster in oversized.tolist():
-        members = np.flatnonzero(label == cluster)
-        for piece in split_cells(rows[members], cols[members], max_cells)[1:]:
-            label[members[piece]] = next_label
-            next_label += 1
-    # Cells are in raster order, so a piece's first cell is its smallest position.
-    first = np.full(next_label, len(label), dtype=np.int64)
-    np.minimum.at(first, label, np.arange(len(label)))
-    rank = np.empty(next_label, dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(next_label)
-    return rank[label]
-
-
 def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.ndarray]:
-    """Split a set of cells recursively until every piece has at most ``max_cells`` cells.
+    """Split one set of cells as :func:`cluster_frontiers` splits a cluster.
 
-    Each split halves the bounding box across its longer side (rows on a tie) at the box's
-    midpoint, so both halves are non-empty. Returns index arrays into ``rows``/``cols``.
+    Returns index arrays into ``rows``/``cols``, one per piece, ordered by their first index.
     """
     if max_cells < 1:
         raise ValueError(f"max_cells must be >= 1, got {max_cells}")
-    row_list, col_list = rows.tolist(), cols.tolist()
-    pieces: list[list[int]] = []
-    stack = [list(range(len(row_list)))]
-    while stack:
-        index = stack.pop()
-        if len(index) <= max_cells:
-            pieces.append(index)
-            continue
-        r = [row_list[i] for i in index]
-        c = [col_list[i] for i in index]
-        values = r if max(r) - min(r) >= max(c) - min(c) else c
-        middle = (min(values) + max(values)) / 2.0
-        low = [i for i, v in zip(index, values, strict=True) if v <= middle]
-        high = [i for i, v in zip(index, values, strict=True) if v > middle]
-        stack.append(high)
-        stack.append(low)
-    pieces.sort(key=min)
-    return [np.array(piece, dtype=np.int64) for piece in pieces]
+    rows = np.asarray(rows, dtype=np.int64)
+    cols = np.asarray(cols, dtype=np.int64)
+    piece, count = split_and_renumber(rows, cols, np.zeros(len(rows), np.int64), 1, max_cells)
+    return [np.flatnonzero(piece == k) for k in range(count)]
 
 
 def unknown_around(belief: np.ndarray, clusters: Clusters) -> np.ndarray:
@@ -178,60 +115,134 @@ def unknown_around(belief: np.ndarray, clusters: Clusters) -> np.ndarray:
     return np.bincount(distinct // (height * width), minlength=clusters.count)
 
 
-def nearest_cells_to_centroids(
-    clusters: Clusters, eligible: np.ndarray
+@compiled
+def frontier_cells(belief: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(mask, rows, cols) of the frontier cells, cells in raster order."""
+    height, width = belief.shape
+    mask = np.zeros((height, width), dtype=np.bool_)
+    rows = np.empty(height * width, dtype=np.int64)
+    cols = np.empty(height * width, dtype=np.int64)
+    n = 0
+    for r in range(height):
+        for c in range(width):
+            if belief[r, c] != FREE:
+                continue
+            if (
+                (r > 0 and belief[r - 1, c] == UNKNOWN)
+                or (r + 1 < height and belief[r + 1, c] == UNKNOWN)
+                or (c > 0 and belief[r, c - 1] == UNKNOWN)
+                or (c + 1 < width and belief[r, c + 1] == UNKNOWN)
+            ):
+                mask[r, c] = True
+                rows[n] = r
+                cols[n] = c
+                n += 1
+    return mask, rows[:n], cols[:n]
+
+
+@compiled
+def clusters_from_labels(
+    image: np.ndarray, rows: np.ndarray, cols: np.ndarray, count: int, max_cells: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cluster index, sizes and centroids of the frontier cells (rows, cols; raster order)
+    labelled 1..count in ``image``, clusters above ``max_cells`` (> 0) split."""
+    label = np.empty(len(rows), dtype=np.int64)
+    for i in range(len(rows)):
+        label[i] = image[rows[i], cols[i]] - 1
+    if max_cells > 0:
+        label, count = split_and_renumber(rows, cols, label, count, max_cells)
+    sizes, centroids = cluster_stats(rows, cols, label, count)
+    return label, sizes, centroids
+
+
+@compiled
+def split_and_renumber(
+    rows: np.ndarray, cols: np.ndarray, label: np.ndarray, count: int, max_cells: int
+) -> tuple[np.ndarray, int]:
+    """Split clusters above ``max_cells`` (see the module docstring) and renumber every
+    piece in raster order of its first cell. ``label`` is 0-based, cells in raster order.
+    Returns the new labels and their count."""
+    n = len(label)
+    # Group cell indices by cluster (counting sort keeps raster order within a cluster).
+    starts = np.zeros(count + 1, dtype=np.int64)
+    for i in range(n):
+        starts[label[i] + 1] += 1
+    for k in range(count):
+        starts[k + 1] += starts[k]
+    order = np.empty(n, dtype=np.int64)
+    fill = starts[:-1].copy()
+    for i in range(n):
+        order[fill[label[i]]] = i
+        fill[label[i]] += 1
+    piece = np.empty(n, dtype=np.int64)
+    pieces = 0
+    stack = np.empty((2 * n + 2, 2), dtype=np.int64)  # segments [lo, hi) of ``order``
+    for k in range(count):
+        stack[0, 0] = starts[k]
+        stack[0, 1] = starts[k + 1]
+        top = 1
+        while top > 0:
+            top -= 1
+            lo = stack[top, 0]
+            hi = stack[top, 1]
+            if hi - lo <= max_cells:
+                for j in range(lo, hi):
+                    piece[order[j]] = pieces
+                pieces += 1
+                continue
+            r_min = r_max = rows[order[lo]]
+            c_min = c_max = cols[order[lo]]
+            for j in range(lo + 1, hi):
+                r = rows[order[j]]
+                c = cols[order[j]]
+                r_min = min(r_min, r)
+                r_max = max(r_max, r)
+                c_min = min(c_min, c)
+                c_max = max(c_max, c)
+            by_rows = r_max - r_min >= c_max - c_min
+            middle = (r_min + r_max) / 2.0 if by_rows else (c_min + c_max) / 2.0
+            # Partition the segment: values <= middle first (order inside a piece is
+            # irrelevant, pieces are renumbered by their first cell below).
+            i = lo
+            j = hi - 1
+            while i <= j:
+                value = rows[order[i]] if by_rows else cols[order[i]]
+                if value <= middle:
+                    i += 1
+                else:
+                    order[i], order[j] = order[j], order[i]
+                    j -= 1
+            stack[top, 0] = lo
+            stack[top, 1] = i
+            stack[top + 1, 0] = i
+            stack[top + 1, 1] = hi
+            top += 2
+    # Renumber pieces by first appearance in raster order.
+    rank = np.full(pieces, -1, dtype=np.int64)
+    out = np.empty(n, dtype=np.int64)
+    seen = 0
+    for i in range(n):
+        p = piece[i]
+        if rank[p] < 0:
+            rank[p] = seen
+            seen += 1
+        out[i] = rank[p]
+    return out, seen
+
+
+@compiled
+def cluster_stats(
+    rows: np.ndarray, cols: np.ndarray, cluster: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """For each cluster, its eligible cell nearest its centroid (ties: raster order).
-
-    Args:
-        clusters: the clusters.
-        eligible: bool per frontier cell (aligned with ``clusters.cell_rows``), e.g. reachable.
-
-    Returns:
-        ``(has_target, targets)``: bool (K,), and int (K, 2) cells (rows of -1 where none).
-    """
-    if kernels.ENABLED:
-        return kernels.nearest_targets(
-            clusters.cell_rows,
-            clusters.cell_cols,
-            clusters.cell_cluster,
-            clusters.centroids,
-            np.asarray(eligible, dtype=bool),
-        )
-    return _nearest_cells_numpy(clusters, eligible)
-
-
-def _nearest_cells_numpy(clusters: Clusters, eligible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    count = clusters.count
-    targets = np.full((count, 2), -1, dtype=np.int64)
-    has_target = np.zeros(count, dtype=bool)
-    if count == 0:
-        return has_target, targets
-    if eligible.all():
-        cluster, rows, cols = clusters.cell_cluster, clusters.cell_rows, clusters.cell_cols
-    else:
-        pick = np.flatnonzero(eligible)
-        if pick.size == 0:
-            return has_target, targets
-        cluster = clusters.cell_cluster[pick]
-        rows, cols = clusters.cell_rows[pick], clusters.cell_cols[pick]
-    centroid = clusters.centroids[cluster]
-    dist2 = (rows - centroid[:, 0]) ** 2 + (cols - centroid[:, 1]) ** 2
-    # Stable sort by (cluster, distance): cells are in raster order, so ties keep raster order.
-    order = np.lexsort((dist2, cluster))
-    sorted_cluster = cluster[order]
-    starts = np.empty(len(order), dtype=bool)
-    starts[0] = True
-    np.not_equal(sorted_cluster[1:], sorted_cluster[:-1], out=starts[1:])
-    first = order[starts]
-    chosen = cluster[first]
-    has_target[chosen] = True
-    targets[chosen, 0] = rows[first]
-    targets[chosen, 1] = cols[first]
-    return has_target, targets
-
-
-def free_components(belief: np.ndarray) -> np.ndarray:
-    """Labels of 4-connected components of known-free cells (0 elsewhere)."""
-    labels, _ = ndimage.label(belief == FREE, structure=_STRUCTURES[4])
-    return labels
+    """Sizes (K,) and centroids (K, 2) of clusters numbered 0..count-1."""
+    sizes = np.zeros(count, dtype=np.int64)
+    sums = np.zeros((count, 2), dtype=np.float64)
+    for i in range(len(cluster)):
+        k = cluster[i]
+        sizes[k] += 1
+        sums[k, 0] += rows[i]
+        sums[k, 1] += cols[i]
+    for k in range(count):
+        sums[k, 0] /= sizes[k]
+        sums[k, 1] /= sizes[k]
+    return sizes, sums

@@ -3,8 +3,8 @@
 Rules (open choices of the thesis, documented in docs/thesis-mapping.md):
 
 * A cluster is *live* for a robot when one of its cells is reachable from the robot through
-  known-free cells; its navigation target is that reachable cell nearest the centroid.
-  Unreachable clusters are dropped (they never get a slot).
+  known-free cells; its navigation target is that reachable cell nearest the centroid (ties:
+  raster order). Unreachable clusters are dropped (they never get a slot).
 * When more live clusters exist than slots, the ``n_slots`` nearest (Euclidean distance from
   the robot to the centroid; ties by cluster index) get a slot.
 * The slots shown are ordered by increasing distance (``sort_by_distance``) or by cluster
@@ -15,16 +15,22 @@ Rules (open choices of the thesis, documented in docs/thesis-mapping.md):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from frontier_marl.core import kernels
+from frontier_marl.core.compiled import compiled
+from frontier_marl.core.frontiers import Clusters
+from frontier_marl.core.grid import FREE
+from frontier_marl.core.planning import distance_field
 
 
 @dataclass(frozen=True)
 class SlotTable:
-    """One robot's slots. Arrays have length ``n_slots``; padding rows hold zeros and -1."""
+    """One robot's slots. Arrays have length ``n_slots``; padding rows hold zeros and -1.
+
+    Read-only by convention: a table is built once per decision and never changed.
+    """
 
     cluster: np.ndarray  # int (n,), cluster index or -1 for padding
     valid: np.ndarray  # bool (n,)
@@ -33,73 +39,130 @@ class SlotTable:
     distance: np.ndarray  # float (n,), Euclidean robot -> centroid
     size: np.ndarray  # int (n,)
     gain: np.ndarray  # float (n,)
-
+    path_length: np.ndarray  # int (n,), known-free shortest path robot -> target, -1 padding
     live: int  # how many slots hold a cluster (the first ``live`` ones)
+    mask: np.ndarray = field(init=False)  # int8 (n,): the live slots, or slot 0 if none
+
+    def __post_init__(self) -> None:
+        mask = self.valid.astype(np.int8)
+        if not self.live:
+            mask[0] = 1  # no live cluster: slot 0 is the idle action
+        object.__setattr__(self, "mask", mask)
 
     def action_mask(self) -> np.ndarray:
         """int8 mask of the actions worth taking: the live slots, or slot 0 (idle) if none."""
-        mask = self.valid.astype(np.int8)
-        if not self.live:
-            mask[0] = 1
-        return mask
+        return self.mask
 
 
-def build_slots(
-    position: np.ndarray,
-    centroids: np.ndarray,
-    sizes: np.ndarray,
+def robot_slots(
+    belief: np.ndarray,
+    position: tuple[int, int],
+    clusters: Clusters,
     gains: np.ndarray,
-    has_target: np.ndarray,
-    targets: np.ndarray,
     n_slots: int,
     sort_by_distance: bool,
 ) -> SlotTable:
-    """Select and order the slots of one robot at ``position`` (row, col)."""
-    if kernels.ENABLED:
-        arrays = kernels.slot_arrays(
-            float(position[0]),
-            float(position[1]),
-            centroids,
-            sizes,
-            gains,
-            has_target,
-            targets,
-            n_slots,
-            sort_by_distance,
-        )
-        return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
-    live, distance = _select_numpy(position, centroids, has_target, n_slots, sort_by_distance)
-    centroid_live = centroids[live]
-    k = len(live)
-    pad = n_slots - k
-    valid = np.zeros(n_slots, dtype=bool)
-    valid[:k] = True
-    return SlotTable(
-        cluster=np.concatenate([live, np.full(pad, -1, dtype=np.int64)]),
-        valid=valid,
-        centroid=np.concatenate([centroid_live, np.zeros((pad, 2))]),
-        target=np.concatenate([targets[live], np.full((pad, 2), -1, dtype=np.int64)]),
-        distance=np.concatenate([distance, np.zeros(pad)]),
-        size=np.concatenate([sizes[live], np.zeros(pad, dtype=np.int64)]),
-        gain=np.concatenate([gains[live], np.zeros(pad)]),
-        live=k,
+    """The slots of the robot standing at ``position`` (row, col) on ``belief``."""
+    arrays = _robot_slots(
+        belief,
+        int(position[0]),
+        int(position[1]),
+        clusters.cell_rows,
+        clusters.cell_cols,
+        clusters.cell_cluster,
+        clusters.centroids,
+        clusters.sizes,
+        gains,
+        n_slots,
+        sort_by_distance,
     )
+    return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
 
 
-def _select_numpy(
-    position: np.ndarray,
+@compiled
+def nearest_targets(
+    rows: np.ndarray,
+    cols: np.ndarray,
+    cluster: np.ndarray,
     centroids: np.ndarray,
-    has_target: np.ndarray,
-    n_slots: int,
-    sort_by_distance: bool,
+    eligible: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(cluster indices, distances) of the slots (the reference of ``kernels.slot_arrays``)."""
+    """Per cluster, its eligible cell nearest the centroid (ties: raster order).
+
+    Returns ``(has_target, targets)``: bool (K,) and int (K, 2) cells (rows of -1 where none).
+    """
+    count = len(centroids)
+    has_target = np.zeros(count, dtype=np.bool_)
+    targets = np.full((count, 2), -1, dtype=np.int64)
+    best = np.full(count, np.inf)
+    for i in range(len(cluster)):
+        if not eligible[i]:
+            continue
+        k = cluster[i]
+        d_row = rows[i] - centroids[k, 0]
+        d_col = cols[i] - centroids[k, 1]
+        dist2 = d_row * d_row + d_col * d_col
+        if dist2 < best[k]:
+            best[k] = dist2
+            has_target[k] = True
+            targets[k, 0] = rows[i]
+            targets[k, 1] = cols[i]
+    return has_target, targets
+
+
+@compiled
+def _robot_slots(
+    belief: np.ndarray,
+    row: int,
+    col: int,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    cell_cluster: np.ndarray,
+    centroids: np.ndarray,
+    sizes: np.ndarray,
+    gains: np.ndarray,
+    n_slots: int,
+    sort: bool,
+) -> tuple[
+    np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
+]:
+    """The arrays of :class:`SlotTable` for the robot at (row, col): reachability and path
+    lengths from one distance field, targets, selection of the nearest, order, padding."""
+    field = distance_field(belief, FREE, row, col)
+    eligible = np.empty(len(rows), dtype=np.bool_)
+    for i in range(len(rows)):
+        eligible[i] = field[rows[i], cols[i]] >= 0
+    has_target, targets = nearest_targets(rows, cols, cell_cluster, centroids, eligible)
     live = np.flatnonzero(has_target)
-    distance = np.hypot(centroids[live, 0] - position[0], centroids[live, 1] - position[1])
+    distance = np.empty(len(live))
+    for i in range(len(live)):
+        distance[i] = np.hypot(centroids[live[i], 0] - row, centroids[live[i], 1] - col)
     if len(live) > n_slots:
-        keep = np.sort(np.argsort(distance, kind="stable")[:n_slots])
-        live, distance = live[keep], distance[keep]
-    if sort_by_distance and len(live) > 1:
-        order = np.argsort(distance, kind="stable")
-        live, distance = live[order], distance[order]
-    return live, distance
+        keep = np.sort(np.argsort(distance, kind="mergesort")[:n_slots])
+        live = live[keep]
+        distance = distance[keep]
+    if sort and len(live) > 1:
+        order = np.argsort(distance, kind="mergesort")
+        live = live[order]
+        distance = distance[order]
+    cluster = np.full(n_slots, -1, dtype=np.int64)
+    valid = np.zeros(n_slots, dtype=np.bool_)
+    centroid = np.zeros((n_slots, 2))
+    target = np.full((n_slots, 2), -1, dtype=np.int64)
+    slot_distance = np.zeros(n_slots)
+    size = np.zeros(n_slots, dtype=np.int64)
+    gain = np.zeros(n_slots)
+    path_length = np.full(n_slots, -1, dtype=np.int64)
+    for slot in range(len(live)):
+        k = live[slot]
+        cluster[slot] = k
+        valid[slot] = True
+        centroid[slot, 0] = centroids[k, 0]
+        centroid[slot, 1] = centroids[k, 1]
+        target[slot, 0] = targets[k, 0]
+        target[slot, 1] = targets[k, 1]
+        slot_distance[slot] = distance[slot]
+        size[slot] = sizes[k]
+        gain[slot] = gains[k]
+        path_length[slot] = field[targets[k, 0], targets[k, 1]]
+    return cluster, valid, centroid, target, slot_distance, size, gain, path_length

@@ -51,8 +51,16 @@ SETTINGS: dict[str, dict[str, Any]] = {
     for name, kwargs in (
         ("thesis-20x20", {"preset": "thesis-20x20"}),
         ("thesis-30x30", {"preset": "thesis-30x30"}),
-        ("rooms-32", {"preset": "thesis-20x20", "map_generator": "rooms", "height": 32,
-                      "width": 32, "max_steps": 1024}),
+        (
+            "rooms-32",
+            {
+                "preset": "thesis-20x20",
+                "map_generator": "rooms",
+                "height": 32,
+                "width": 32,
+                "max_steps": 1024,
+            },
+        ),
     )
     for mode in ("static", "dynamic")
     for agents in (1, 4)
@@ -60,17 +68,34 @@ SETTINGS: dict[str, dict[str, Any]] = {
 
 #: Observation, reward and movement variants, played by two policies each.
 VARIANTS: dict[str, dict[str, Any]] = {
-    "relative-sorted-reward1": {"centroid": "relative", "agent_position": False,
-                                "sort_by_distance": True, "reward": "reward1"},
-    "gain-only-normalized": {"centroid": "none", "agent_position": False, "info_gain": True,
-                             "normalize": True, "gain": "unknown"},
+    "relative-sorted-reward1": {
+        "centroid": "relative",
+        "agent_position": False,
+        "sort_by_distance": True,
+        "reward": "reward1",
+    },
+    "gain-only-normalized": {
+        "centroid": "none",
+        "agent_position": False,
+        "info_gain": True,
+        "normalize": True,
+        "gain": "unknown",
+    },
     "distance-mask-square": {"centroid": "distance", "action_mask": True, "sensor": "square"},
     "full-path-8-slots": {"cells_per_step": "full", "n_slots": 8, "info_gain": True},
     "two-cells-4-connected": {"cells_per_step": 2, "connectivity": 4, "max_cluster_cells": 4},
-    "team-targets-shared-reward": {"n_agents": 3, "teammates": "positions+targets",
-                                   "team_weight": 0.5, "map_mode": "dynamic"},
-    "team-positions-30x30": {"preset": "thesis-30x30", "n_agents": 2,
-                             "teammates": "positions", "normalize": True},
+    "team-targets-shared-reward": {
+        "n_agents": 3,
+        "teammates": "positions+targets",
+        "team_weight": 0.5,
+        "map_mode": "dynamic",
+    },
+    "team-positions-30x30": {
+        "preset": "thesis-30x30",
+        "n_agents": 2,
+        "teammates": "positions",
+        "normalize": True,
+    },
 }
 VARIANT_POLICIES = ("greedy-distance", "random")
 

@@ -23,16 +23,53 @@ _SINGLE = "greedy-distance,greedy-gain,cost-utility,random,first-slot"
 _TEAM = "greedy-distance,cost-utility,coordinated-assignment,utility-discount"
 
 COMMANDS: dict[str, list[str]] = {
-    "baselines-20x20-static": ["baselines", "--preset", "thesis-20x20", "--map-mode", "static",
-                               "--policies", _SINGLE],
-    "baselines-20x20-dynamic": ["baselines", "--preset", "thesis-20x20", "--map-mode",
-                                "dynamic", "--policies", _SINGLE],
-    "baselines-30x30-static": ["baselines", "--preset", "thesis-30x30", "--map-mode", "static",
-                               "--policies", _SINGLE],
-    "baselines-30x30-dynamic": ["baselines", "--preset", "thesis-30x30", "--map-mode",
-                                "dynamic", "--policies", _SINGLE],
-    "baselines-rooms64-team": ["baselines", "--map", "rooms-64", "--agents", "4", "--policies",
-                               _TEAM, "--episodes", "10"],
+    "baselines-20x20-static": [
+        "baselines",
+        "--preset",
+        "thesis-20x20",
+        "--map-mode",
+        "static",
+        "--policies",
+        _SINGLE,
+    ],
+    "baselines-20x20-dynamic": [
+        "baselines",
+        "--preset",
+        "thesis-20x20",
+        "--map-mode",
+        "dynamic",
+        "--policies",
+        _SINGLE,
+    ],
+    "baselines-30x30-static": [
+        "baselines",
+        "--preset",
+        "thesis-30x30",
+        "--map-mode",
+        "static",
+        "--policies",
+        _SINGLE,
+    ],
+    "baselines-30x30-dynamic": [
+        "baselines",
+        "--preset",
+        "thesis-30x30",
+        "--map-mode",
+        "dynamic",
+        "--policies",
+        _SINGLE,
+    ],
+    "baselines-rooms64-team": [
+        "baselines",
+        "--map",
+        "rooms-64",
+        "--agents",
+        "4",
+        "--policies",
+        _TEAM,
+        "--episodes",
+        "10",
+    ],
     "evaluate-shipped-model": ["evaluate", "thesis-config01"],
 }
 
@@ -50,7 +87,7 @@ def _strip_config(value: Any) -> Any:
 
 
 def run(name: str) -> dict[str, Any]:
-    """The command's table (its printed lines, file paths replaced by ``<path>``) and its JSON digest."""
+    """The command's table (printed lines, file paths as ``<path>``) and its JSON digest."""
     from frontier_marl.cli import main
 
     with tempfile.TemporaryDirectory() as folder:

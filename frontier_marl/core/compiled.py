@@ -1,0 +1,25 @@
+"""The core's one compiler: numba's ``njit`` with an on-disk cache.
+
+Every hot loop of the simulator (frontier cells, splitting, cluster statistics, targets, slots,
+shortest paths, ray casting, the walk) has exactly one implementation, a numba-compiled
+function next to the operation it implements; docs/performance.md says why. The functions
+compile once per machine (about 10 s, then cached beside the module or in numba's user cache).
+For debugging, numba's own ``NUMBA_DISABLE_JIT=1`` runs the same functions as plain Python.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+import numba
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def compiled(function: F) -> F:
+    """``numba.njit`` with an on-disk cache; without one if no cache folder is writable."""
+    try:
+        return numba.njit(cache=True, nogil=True)(function)  # type: ignore[no-any-return]
+    except RuntimeError:  # numba found no writable cache location: compile in every process
+        return numba.njit(nogil=True)(function)  # type: ignore[no-any-return]
