@@ -71,8 +71,8 @@ def explore_bench_settings(map_file: Path) -> list[tuple[str, dict[str, Any]]]:
 
 
 def nearest(info: dict[str, Any], rng: np.random.Generator) -> int:
-    clusters = info["clusters"]
-    return min(clusters, key=lambda c: c["distance"])["slot"] if clusters else 0
+    table = info["slots"]
+    return int(np.argmin(table.distance[: table.live])) if table.live else 0
 
 
 def random_valid(info: dict[str, Any], rng: np.random.Generator) -> int:
@@ -175,7 +175,7 @@ def train_interleaved(envs: dict[str, gym.Env], steps: int, chunks: int) -> dict
 def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, Any]:
     """Train the thesis's DQN on the env and on a null env with the same spaces, interleaved
     (:func:`train_interleaved`): back-to-back runs disagreed by several points."""
-    real = frontier_marl.FrontierExploreEnv(preset="thesis-20x20")
+    real = frontier_marl.FrontierExploreEnv(preset="thesis-20x20", info="minimal")
     seconds = train_interleaved({"null": NullEnv(real), "env": real}, steps, chunks)
     timings = {name: sum(chunk) for name, chunk in seconds.items()}
     share = (timings["env"] - timings["null"]) / timings["env"]

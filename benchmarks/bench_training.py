@@ -55,6 +55,7 @@ def stage_functions() -> list[tuple[object, str]]:
     """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
     from frontier_marl import engine
     from frontier_marl.core import world
+    from frontier_marl.envs import parallel
 
     return [
         (world.World, "move"),  # planning, walking, sensing
@@ -62,7 +63,7 @@ def stage_functions() -> list[tuple[object, str]]:
         (ndimage, "label"),
         (engine.ExplorationMDP, "_observations"),
         (engine, "step_outcome"),  # the reward table
-        (engine.ExplorationMDP, "_infos"),
+        (parallel, "build_infos"),  # the info dicts
         (engine.ExplorationMDP, "reset"),
     ]
 

@@ -2,8 +2,10 @@
 
 :class:`ExplorationMDP` owns a :class:`~frontier_marl.core.world.World` and turns one action per
 robot (a cluster slot index) into targets, moves the robots, applies the reward table, and
-encodes the next observations. It holds no RNG of its own: ``reset`` takes a
-``numpy.random.Generator`` from the adapter, so one seed fixes the whole episode.
+encodes the next observations. Its step returns typed arrays (:class:`StepResult`); the
+adapters build their info dicts from those (:mod:`frontier_marl.envs.infos`). It holds no RNG of
+its own: ``reset`` takes a ``numpy.random.Generator`` from the adapter, so one seed fixes the
+whole episode.
 """
 
 from __future__ import annotations
@@ -24,38 +26,40 @@ from frontier_marl.core.maps import (
 )
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.slots import SlotTable
-from frontier_marl.core.world import FULL_PATH, World, WorldParams
+from frontier_marl.core.world import FULL_PATH, MoveResult, World, WorldParams
 from frontier_marl.observations import ObservationEncoder
-from frontier_marl.rewards import OscillationDetector, StepEvents, step_outcome
+from frontier_marl.rewards import OscillationDetector, StepEvents, StepOutcome, step_outcome
 
 Observation = np.ndarray | dict[str, np.ndarray]
 
 
-class StepInfo(dict):  # type: ignore[type-arg]
-    """One robot's info dict. ``copy.deepcopy`` of it is a shallow copy.
+@dataclass(frozen=True)
+class StepResult:
+    """One decision step of every robot, as arrays indexed by robot (read-only by convention).
 
-    SB3's ``DummyVecEnv`` deep-copies every info on every step, in case an env reuses and
-    mutates them. This env never does: each step builds fresh values (arrays, tuples, lists of
-    fresh dicts) and never touches them again, so a shallow copy is as safe. It costs ~1 µs
-    where a real deep copy of this info costs ~28 µs (warm; more inside training).
-    Treat the values as read-only.
+    ``targets`` holds the cell each robot headed for (row -1: it idled); ``padding`` whether it
+    chose a padding slot while a live one existed; ``move`` what the walk did (new cells,
+    paths, whether each robot reached its target); ``outcome`` the rewards and the episode end.
     """
 
-    __slots__ = ()
-
-    def __deepcopy__(self, memo: dict[int, Any]) -> StepInfo:
-        return StepInfo(self)
-
-
-@dataclass(frozen=True)
-class Transition:
-    """Result of one decision step for all robots (lists are indexed by robot)."""
-
     observations: list[Observation]
-    rewards: np.ndarray
-    terminated: bool
-    truncated: bool
-    infos: list[dict[str, Any]]
+    targets: np.ndarray  # int (N, 2)
+    padding: np.ndarray  # bool (N,)
+    oscillation: np.ndarray  # bool (N,)
+    move: MoveResult
+    outcome: StepOutcome
+
+    @property
+    def rewards(self) -> np.ndarray:
+        return self.outcome.rewards
+
+    @property
+    def terminated(self) -> bool:
+        return self.outcome.terminated
+
+    @property
+    def truncated(self) -> bool:
+        return self.outcome.truncated
 
 
 class ExplorationMDP:
@@ -77,7 +81,8 @@ class ExplorationMDP:
         self.world: World | None = None
         self._slots: list[SlotTable] = []
         self._oscillation: list[OscillationDetector] = []
-        self._targets: list[tuple[int, int] | None] = []
+        self._heading = np.full((cfg.n_agents, 2), -1, dtype=np.int64)  # -1: no target
+        self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
         self.steps_without_progress = 0
         self.done = True
@@ -103,7 +108,7 @@ class ExplorationMDP:
             return rooms_map(cfg.height, cfg.width, rng)
         return random_obstacle_map(cfg.height, cfg.width, cfg.obstacle_prob, rng)
 
-    def reset(self, rng: np.random.Generator) -> tuple[list[Observation], list[dict[str, Any]]]:
+    def reset(self, rng: np.random.Generator) -> list[Observation]:
         """Start an episode: map, start cells in the largest free component, first sensing."""
         cfg = self.cfg
         true_grid = self.true_grid_for_episode(rng)
@@ -120,14 +125,12 @@ class ExplorationMDP:
         self.steps = 0
         self.steps_without_progress = 0
         self.done = False
-        self._targets = [None] * cfg.n_agents
+        self.last = None
+        self._heading[:] = -1
         self._refresh_slots()
-        n = cfg.n_agents
-        empty_paths = [self.world.positions[i][None, :].copy() for i in range(n)]
-        infos = self._infos([0] * n, empty_paths, [None] * n, [False] * n, [False] * n, "")
-        return self._observations(), infos
+        return self._observations()
 
-    def step(self, actions: list[Any]) -> Transition:
+    def step(self, actions: list[Any]) -> StepResult:
         """One decision per robot: ``actions[i]`` is robot i's slot index."""
         if self.world is None or self.done:
             raise RuntimeError("step() called before reset() or after the episode ended")
@@ -135,27 +138,22 @@ class ExplorationMDP:
         n = cfg.n_agents
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
-        targets: list[tuple[int, int] | None] = []
-        padding: list[bool] = []
-        for agent, action in enumerate(actions):
-            slot = self._check_action(action, agent)
-            table = self._slots[agent]
+        slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
+        targets = np.full((n, 2), -1, dtype=np.int64)
+        padding = np.zeros(n, dtype=bool)
+        oscillation = np.zeros(n, dtype=bool)
+        for agent, (slot, table) in enumerate(zip(slots, self._slots, strict=True)):
             if slot < table.live:  # live slots come first
+                targets[agent] = table.target[slot]
                 row, col = table.target[slot].tolist()
-                targets.append((row, col))
-                padding.append(False)
+                oscillation[agent] = self._oscillation[agent].update((row, col))
             else:
-                targets.append(None)
-                padding.append(table.live > 0)
-        oscillation = [
-            detector.update(t) for detector, t in zip(self._oscillation, targets, strict=True)
-        ]
+                padding[agent] = table.live > 0
+                oscillation[agent] = self._oscillation[agent].update(None)
         world = self.world
         moved = world.move(targets)
-        self._targets = [
-            None if target is None or reached else target
-            for target, reached in zip(targets, moved.reached.tolist(), strict=True)
-        ]
+        self._heading[:] = targets
+        self._heading[moved.reached] = -1
         self.steps += 1
         new_cells = moved.new_cells.tolist()
         self.steps_without_progress = 0 if any(new_cells) else self.steps_without_progress + 1
@@ -163,8 +161,8 @@ class ExplorationMDP:
         fraction = world.explored_fraction(cfg.reward.threshold_basis)
         events = StepEvents(
             new_cells=new_cells,
-            padding=padding,
-            oscillation=oscillation,
+            padding=padding.tolist(),
+            oscillation=oscillation.tolist(),
             threshold_reached=fraction >= cfg.reward.explore_threshold,
             no_frontier_left=not any(table.live for table in self._slots),
             steps_taken=self.steps,
@@ -172,10 +170,8 @@ class ExplorationMDP:
         )
         outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
-        infos = self._infos(new_cells, moved.paths, targets, padding, oscillation, outcome.reason)
-        return Transition(
-            self._observations(), outcome.rewards, outcome.terminated, outcome.truncated, infos
-        )
+        self.last = StepResult(self._observations(), targets, padding, oscillation, moved, outcome)
+        return self.last
 
     # ------------------------------------------------------------------ helpers
     def _check_action(self, action: Any, agent: int) -> int:
@@ -214,7 +210,7 @@ class ExplorationMDP:
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
-        return [table.action_mask() for table in self._slots]
+        return [table.mask for table in self._slots]
 
     def _observations(self) -> list[Observation]:
         assert self.world is not None
@@ -230,70 +226,12 @@ class ExplorationMDP:
         ]
 
     def _teammate_table(self, positions: np.ndarray) -> np.ndarray | None:
-        """(N, 2) positions, or (N, 4) positions and current targets; None if not observed."""
+        """(N, 2) positions, or (N, 4) positions and current targets (zeros where a robot has
+        none); None if not observed."""
         layout = self.cfg.observation.teammates
         if layout == "none":
             return None
         if layout == "positions":
             return positions.astype(np.float64)
-        targets = np.zeros((len(positions), 2))
-        for agent, target in enumerate(self._targets):
-            if target is not None:
-                targets[agent] = target
+        targets = np.where(self._heading < 0, 0, self._heading).astype(np.float64)
         return np.concatenate([positions, targets], axis=1)
-
-    def _infos(
-        self,
-        new_cells: list[int],
-        paths: list[np.ndarray],
-        targets: list[tuple[int, int] | None],
-        padding: list[bool],
-        oscillation: list[bool],
-        reason: str,
-    ) -> list[dict[str, Any]]:
-        assert self.world is not None
-        world = self.world
-        fraction = world.explored_fraction(self.cfg.reward.threshold_basis)
-        coverage = world.explored_fraction("reachable")
-        positions = world.positions.tolist()
-        travelled = world.travelled.tolist()
-        infos = []
-        for agent, table in enumerate(self._slots):
-            clusters = [
-                {
-                    "slot": slot,
-                    "cluster": cluster,
-                    "centroid": tuple(centroid),
-                    "target": tuple(target),
-                    "size": size,
-                    "gain": gain,
-                    "distance": distance,
-                }
-                for slot, cluster, centroid, target, size, gain, distance in zip(  # noqa: B905
-                    range(table.live),  # the shortest: zip stops after the live slots
-                    table.cluster.tolist(),
-                    table.centroid.tolist(),
-                    table.target.tolist(),
-                    table.size.tolist(),
-                    table.gain.tolist(),
-                    table.distance.tolist(),
-                )
-            ]
-            infos.append(
-                StepInfo(
-                    explored_fraction=fraction,
-                    coverage=coverage,
-                    new_cells=new_cells[agent],
-                    action_mask=table.action_mask(),
-                    clusters=clusters,
-                    path=paths[agent],
-                    target=targets[agent],
-                    position=tuple(positions[agent]),
-                    travelled=travelled[agent],
-                    padding=padding[agent],
-                    oscillation=oscillation[agent],
-                    step=self.steps,
-                    end_reason=reason,
-                )
-            )
-        return infos

@@ -9,29 +9,25 @@ env (:meth:`Policy.act`) and with every robot of the PettingZoo ParallelEnv
     obs, infos = par_env.reset(seed=0)
     actions = policy.act_team(obs, infos)          # {"robot_0": slot, ...}
 
-The heuristics read only a robot's step info (``clusters`` with slot, centroid, target, size,
-gain and distance per live slot; ``action_mask``; ``position``), never hidden env state:
+The heuristics read only a robot's step info: its typed slot table ``info["slots"]`` (cluster,
+target, Euclidean centroid ``distance``, known-free ``path_length``, size and ``gain`` per
+slot; see :class:`~frontier_marl.core.slots.SlotTable`) and ``action_mask``, never hidden env
+state:
 
 * ``greedy-distance``: the nearest cluster (smallest Euclidean centroid ``distance``; ties:
   lowest slot).
 * ``greedy-gain``: the largest information ``gain`` (ties: nearest, then lowest slot).
 * ``cost-utility``: the largest ``gain / path length``, the path length being the 4-connected
   shortest path (what A* returns) from the robot to the cluster's target over the known-free
-  cells of the robot's own map (the belief grid). Ties: nearest, then lowest slot. The belief
-  is not part of the standard info, so the policy takes it from ``info["belief"]`` when present,
-  else from the env passed to :meth:`Policy.attach` (``env.unwrapped.world.belief``: the map
-  the robots have built, i.e. what they know, not hidden state). :func:`frontier_marl.
-  evaluation.evaluate` attaches the env automatically.
+  cells of the belief (a length of 0 counts as 1). Ties: nearest, then lowest slot.
 * ``random``: uniform over the valid slots of ``action_mask``, from its own seeded generator.
 * ``first-slot``: always slot 0, the thesis's degenerate policy as a baseline (greedy distance
   when slots are sorted; the top-most of the selected clusters when unsorted).
 
 Two *joint* heuristics decide for the whole team at once (:meth:`Policy.act_team`). They read
-each robot's ``clusters`` and ``position`` and the shared belief (from ``info["belief"]`` or the
-attached env, as ``cost-utility``). Clusters are matched across robots by their ``cluster``
-index, which is the same for every robot because the belief is shared. Path costs are
-4-connected shortest path lengths over the known-free cells (what A* returns), one BFS per
-robot per step.
+each robot's slot table. Clusters are matched across robots by their ``cluster`` index, which
+is the same for every robot because the belief is shared. Path costs are the slots' known-free
+path lengths.
 
 * ``coordinated-assignment``: an optimal assignment of robots to distinct clusters
   (``scipy.optimize.linear_sum_assignment`` on the robots x clusters path-cost matrix, a robot
@@ -49,9 +45,9 @@ robot per step.
   ties: smaller path, then agent order, then slot) is fixed, then every target t' loses
   ``P(||t - t'||)`` of its utility, ``P(d) = max(0, 1 - d / r)`` (a linear visibility
   probability, Euclidean distance between target cells, ``r`` the sensor range: the env's
-  ``perception_range`` or ``sensor_range=``). ``beta = 1``. A claimed target drops to utility
-  0 for the others, so duplicates are discouraged but not forbidden. With one robot: its
-  nearest cluster by path length, as ``coordinated-assignment``.
+  ``perception_range``, read by :meth:`Policy.attach`, or ``sensor_range=``). ``beta = 1``. A
+  claimed target drops to utility 0 for the others, so duplicates are discouraged but not
+  forbidden. With one robot: its nearest cluster by path length, as ``coordinated-assignment``.
 
 With no live cluster every heuristic returns slot 0 (the env's idle action).
 
@@ -66,8 +62,7 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.core.grid import FREE
-from frontier_marl.core.planning import distance_field, distance_fields
+from frontier_marl.core.slots import SlotTable
 
 Info = Mapping[str, Any]
 
@@ -113,11 +108,18 @@ class HeuristicPolicy(Policy):
         raise NotImplementedError
 
 
-def _clusters(info: Info) -> list[Mapping[str, Any]]:
+def _slots(info: Info) -> SlotTable:
     try:
-        return list(info["clusters"])
+        return info["slots"]
     except (KeyError, TypeError) as exc:
-        raise ValueError("info must hold a 'clusters' list (the env's step info)") from exc
+        raise ValueError(
+            "info must hold the robot's 'slots' table (the env's step info with info='full')"
+        ) from exc
+
+
+def _first(*keys: np.ndarray) -> int:
+    """The index that sorts first by ``keys`` (the first key most significant; ties: lowest)."""
+    return int(np.lexsort((np.arange(len(keys[0])), *reversed(keys)))[0])
 
 
 class GreedyDistance(HeuristicPolicy):
@@ -126,11 +128,10 @@ class GreedyDistance(HeuristicPolicy):
     name = "greedy-distance"
 
     def choose(self, info: Info) -> int:
-        clusters = _clusters(info)
-        if not clusters:
+        table = _slots(info)
+        if not table.live:
             return 0
-        best = min(clusters, key=lambda c: (float(c["distance"]), int(c["slot"])))
-        return int(best["slot"])
+        return int(np.argmin(table.distance[: table.live]))
 
 
 class GreedyGain(HeuristicPolicy):
@@ -139,13 +140,11 @@ class GreedyGain(HeuristicPolicy):
     name = "greedy-gain"
 
     def choose(self, info: Info) -> int:
-        clusters = _clusters(info)
-        if not clusters:
+        table = _slots(info)
+        if not table.live:
             return 0
-        best = min(
-            clusters, key=lambda c: (-float(c["gain"]), float(c["distance"]), int(c["slot"]))
-        )
-        return int(best["slot"])
+        live = table.live
+        return _first(-table.gain[:live], table.distance[:live])
 
 
 class FirstSlot(HeuristicPolicy):
@@ -162,72 +161,22 @@ class FirstSlot(HeuristicPolicy):
 
 
 class CostUtility(HeuristicPolicy):
-    """Largest ``gain / path length`` (path over the known-free cells of the robot's map).
-
-    The map comes from ``info["belief"]`` if the info has it, else from the attached env's
-    ``unwrapped.world.belief``. A path length of 0 (robot on the target) counts as 1; a
-    target with no known-free path (never the case for the env's live slots) is skipped.
-    """
+    """Largest ``gain / path length`` (known-free path; a length of 0 counts as 1); ties go to
+    the nearest, then the lowest slot."""
 
     name = "cost-utility"
 
-    def __init__(self) -> None:
-        self._belief_source: Callable[[], np.ndarray] | None = None
-
-    def attach(self, env: Any) -> None:
-        unwrapped = getattr(env, "unwrapped", env)
-        if "world" not in dir(unwrapped):  # dir(): the property raises before reset()
-            raise ValueError(
-                f"cost-utility needs an env with a .world (the robots' map); got {type(env)}"
-            )
-        self._belief_source = lambda: unwrapped.world.belief
-
-    def _belief(self, info: Info) -> np.ndarray:
-        if "belief" in info:
-            return np.asarray(info["belief"])
-        if self._belief_source is None:
-            raise ValueError(
-                "cost-utility needs the robot's map: put it in info['belief'] "
-                "or call policy.attach(env) first"
-            )
-        return np.asarray(self._belief_source())
-
-    def path_lengths(self, info: Info) -> dict[int, int]:
-        """Shortest known-free path length from the robot to each live slot's target
-        (-1 where unreachable)."""
-        clusters = _clusters(info)
-        if not clusters:
-            return {}
-        belief = self._belief(info)
-        row, col = (int(v) for v in info["position"])
-        distances = distance_field(belief, FREE, row, col)
-        lengths = {}
-        for c in clusters:
-            t_row, t_col = (int(v) for v in c["target"])
-            lengths[int(c["slot"])] = int(distances[t_row, t_col])
-        return lengths
-
-    def utilities(self, info: Info) -> dict[int, float]:
-        """``gain / max(path length, 1)`` per live slot; ``-inf`` where unreachable."""
-        lengths = self.path_lengths(info)
-        out = {}
-        for c in _clusters(info):
-            length = lengths[int(c["slot"])]
-            out[int(c["slot"])] = (
-                float(c["gain"]) / max(length, 1) if length >= 0 else float("-inf")
-            )
-        return out
+    @staticmethod
+    def utilities(table: SlotTable) -> np.ndarray:
+        """``gain / max(path length, 1)`` of each live slot."""
+        live = table.live
+        return table.gain[:live] / np.maximum(table.path_length[:live], 1)
 
     def choose(self, info: Info) -> int:
-        clusters = _clusters(info)
-        if not clusters:
+        table = _slots(info)
+        if not table.live:
             return 0
-        utility = self.utilities(info)
-        best = min(
-            clusters,
-            key=lambda c: (-utility[int(c["slot"])], float(c["distance"]), int(c["slot"])),
-        )
-        return int(best["slot"])
+        return _first(-self.utilities(table), table.distance[: table.live])
 
 
 class RandomValid(HeuristicPolicy):
@@ -247,10 +196,7 @@ class RandomValid(HeuristicPolicy):
             self._rng = np.random.default_rng(seed)
 
     def choose(self, info: Info) -> int:
-        if "action_mask" in info:
-            valid = np.flatnonzero(np.asarray(info["action_mask"]))
-        else:
-            valid = np.array([int(c["slot"]) for c in _clusters(info)], dtype=np.int64)
+        valid = np.flatnonzero(np.asarray(info["action_mask"]))
         if len(valid) == 0:
             return 0
         return int(valid[self._rng.integers(len(valid))])
@@ -269,57 +215,36 @@ class _Option:
 
 
 class TeamHeuristic(Policy):
-    """Base of the joint heuristics: robots x clusters path lengths on the shared belief.
+    """Base of the joint heuristics: robots x clusters path lengths from the slot tables.
 
-    The belief comes from ``info["belief"]`` (any robot's info) when present, else from the env
-    given to :meth:`attach`. :meth:`act` treats one robot as a team of one.
+    :meth:`act` treats one robot as a team of one.
     """
 
     def __init__(self) -> None:
-        self._world_source: Callable[[], Any] | None = None
         self._config: Any = None
 
     def attach(self, env: Any) -> None:
-        unwrapped = getattr(env, "unwrapped", env)
-        if "world" not in dir(unwrapped):  # dir(): the property raises before reset()
-            raise ValueError(
-                f"{self.name} needs an env with a .world (the robots' map); got {type(env)}"
-            )
-        self._world_source = lambda: unwrapped.world
-        self._config = getattr(unwrapped, "config", None)
+        self._config = getattr(getattr(env, "unwrapped", env), "config", None)
 
-    def _belief(self, infos: Sequence[Info]) -> np.ndarray:
-        for info in infos:
-            if "belief" in info:
-                return np.asarray(info["belief"])
-        if self._world_source is None:
-            raise ValueError(
-                f"{self.name} needs the robots' map: put it in info['belief'] "
-                "or call policy.attach(env) first"
-            )
-        return np.asarray(self._world_source().belief)
-
-    def options(self, infos: Sequence[Info]) -> list[list[_Option]]:
-        """Per robot (in the given order), its live clusters with their path lengths;
-        clusters with no known-free path (never the case for the env's live slots) are left
-        out."""
-        per_agent = [_clusters(info) for info in infos]
-        if not any(per_agent):
-            return [[] for _ in infos]
-        belief = self._belief(infos)
-        positions = [tuple(int(v) for v in info["position"]) for info in infos]
-        fields = distance_fields(belief == FREE, positions)
+    @staticmethod
+    def options(infos: Sequence[Info]) -> list[list[_Option]]:
+        """Per robot (in the given order), its live clusters with their path lengths."""
         out = []
-        for agent, clusters in enumerate(per_agent):
-            mine = []
-            for c in clusters:
-                row, col = (int(v) for v in c["target"])
-                length = int(fields[agent, row, col])
-                if length >= 0:
-                    mine.append(
-                        _Option(agent, int(c["cluster"]), int(c["slot"]), length, (row, col))
-                    )
-            out.append(mine)
+        for agent, info in enumerate(infos):
+            table = _slots(info)
+            live = table.live
+            rows = zip(
+                table.cluster[:live].tolist(),
+                table.path_length[:live].tolist(),
+                table.target[:live].tolist(),
+                strict=True,
+            )
+            out.append(
+                [
+                    _Option(agent, cluster, slot, length, (row, col))
+                    for slot, (cluster, length, (row, col)) in enumerate(rows)
+                ]
+            )
         return out
 
     def act(self, obs: Any, info: Info) -> int:

@@ -65,7 +65,7 @@ def test_make_by_id(preset: str) -> None:
     obs, info = env.reset(seed=0)
     assert env.observation_space.contains(obs)
     assert base.world.true_grid.shape == (side, side)
-    assert {"explored_fraction", "new_cells", "action_mask", "clusters", "path"} <= set(info)
+    assert {"explored_fraction", "new_cells", "action_mask", "slots", "path"} <= set(info)
 
 
 def test_make_passes_overrides() -> None:

@@ -24,7 +24,7 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
         "ndimage.label",
         "_observations",
         "step_outcome",
-        "_infos",
+        "build_infos",
         "reset",
     }
     assert stages["move"]["calls"] == 600 - 1  # one per env step, the first left out

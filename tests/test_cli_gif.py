@@ -55,7 +55,7 @@ def test_frame_matches_env_render_at_default_size():
     env = frontier_marl.parallel_env(render_mode="rgb_array", **SMALL)
     _, infos = env.reset(seed=4)
     _, _, _, _, infos = env.step({"robot_0": 0})
-    np.testing.assert_array_equal(render_frame(env, infos, 12), env.render())
+    np.testing.assert_array_equal(render_frame(env, 12), env.render())
 
 
 @pytest.mark.parametrize("argv", [["--fps", "0"], ["--set", "sensor=sonar"]])

@@ -18,7 +18,7 @@ INFO_KEYS = {
     "coverage",
     "new_cells",
     "action_mask",
-    "clusters",
+    "slots",
     "path",
     "target",
     "position",
@@ -28,7 +28,7 @@ INFO_KEYS = {
     "step",
     "end_reason",
 }
-CLUSTER_KEYS = {"slot", "cluster", "centroid", "target", "size", "gain", "distance"}
+CLUSTER_KEYS = {"slot", "cluster", "centroid", "target", "size", "gain", "distance", "path_length"}
 FOUR = ndimage.generate_binary_structure(2, 1)
 
 
@@ -255,7 +255,7 @@ def _check_infos(env: Any, infos: dict[str, Any]) -> None:
         assert info["position"] == tuple(world.positions[index].tolist())
         mask = info["action_mask"]
         assert mask.dtype == np.int8 and mask.shape == (env.config.n_slots,)
-        live = info["clusters"]
+        live = info["slots"].rows()
         for entry in live:
             assert set(entry) == CLUSTER_KEYS
         slots = [entry["slot"] for entry in live]
@@ -331,7 +331,7 @@ def test_sorted_layout_orders_slots_by_distance() -> None:
         _, plain = plain_env.reset(seed=seed)
         for _ in range(5):
             for agent in sorted_env.agents:
-                s, p = infos[agent]["clusters"], plain[agent]["clusters"]
+                s, p = infos[agent]["slots"].rows(), plain[agent]["slots"].rows()
                 distances = [e["distance"] for e in s]
                 assert distances == sorted(distances)
                 ids = [e["cluster"] for e in p]
@@ -344,10 +344,14 @@ def test_sorted_layout_orders_slots_by_distance() -> None:
             # Same target in both envs so the two stay in the same state.
             actions, plain_actions = {}, {}
             for agent in sorted_env.agents:
-                entry = infos[agent]["clusters"][int(rng.integers(len(infos[agent]["clusters"])))]
+                entry = infos[agent]["slots"].rows()[
+                    int(rng.integers(len(infos[agent]["slots"].rows())))
+                ]
                 actions[agent] = entry["slot"]
                 plain_actions[agent] = next(
-                    e["slot"] for e in plain[agent]["clusters"] if e["cluster"] == entry["cluster"]
+                    e["slot"]
+                    for e in plain[agent]["slots"].rows()
+                    if e["cluster"] == entry["cluster"]
                 )
             _, _, _, _, infos = sorted_env.step(actions)
             _, _, _, _, plain = plain_env.step(plain_actions)
@@ -388,7 +392,7 @@ def test_cluster_features_encode_the_slot_table(centroid: str, normalize: bool) 
             position = np.asarray(env.world.positions[index], dtype=float)
             expected_position = position / ([height, width] if normalize else [1, 1])
             np.testing.assert_allclose(obs[agent]["agent_position"], expected_position, rtol=1e-6)
-            live = infos[agent]["clusters"]
+            live = infos[agent]["slots"].rows()
             for entry in live:
                 centroid_arr = np.array(entry["centroid"])
                 feature = {
@@ -417,11 +421,11 @@ def test_relative_encoding_flat_box() -> None:
     for _ in range(30):
         table = obs.reshape(6, 2)
         position = np.array(info["position"], dtype=float)
-        for entry in info["clusters"]:
+        for entry in info["slots"].rows():
             np.testing.assert_allclose(
                 table[entry["slot"]], np.array(entry["centroid"]) - position, atol=1e-5
             )
-        assert not table[len(info["clusters"]) :].any()
+        assert not table[len(info["slots"].rows()) :].any()
         obs, _, terminated, truncated, info = env.step(
             int(rng.choice(np.flatnonzero(info["action_mask"])))
         )
@@ -489,13 +493,13 @@ def test_no_frontier_left_terminates() -> None:
     _, _, terms, truncs, infos = _explore_fully(env, seed=0)
     assert terms == {"robot_0": True} and truncs == {"robot_0": False}
     assert infos["robot_0"]["end_reason"] == "no_frontier"
-    assert infos["robot_0"]["clusters"] == []
+    assert infos["robot_0"]["slots"].rows() == []
 
 
 def test_observation_mask_matches_info_mask_without_live_slots() -> None:
     env = frontier_marl.parallel_env(n_agents=1, action_mask=True, **FULL)
     obs, _, _, _, infos = _explore_fully(env, seed=0)
-    assert infos["robot_0"]["clusters"] == []
+    assert infos["robot_0"]["slots"].rows() == []
     np.testing.assert_array_equal(obs["robot_0"]["action_mask"], infos["robot_0"]["action_mask"])
 
 

@@ -34,7 +34,7 @@ TINY = {
 
 def nearest(info: dict) -> int:
     """Greedy distance, written independently of frontier_marl.policies."""
-    clusters = info["clusters"]
+    clusters = info["slots"].rows()
     if not clusters:
         return 0
     return sorted(clusters, key=lambda c: (c["distance"], c["slot"]))[0]["slot"]

@@ -31,6 +31,7 @@ from frontier_marl.policies import (
     make_policy,
 )
 from frontier_marl.rewards import StepEvents, step_outcome
+from tests.helpers import info_with, live_slot
 from tests.oracles import bfs as bfs_distances
 
 REPO = Path(__file__).resolve().parents[1]
@@ -59,7 +60,7 @@ def corridor_env(path: str, **kwargs: Any) -> tuple[Any, dict, dict]:
 
 
 def slot_of(info: dict, target: tuple[int, int]) -> int:
-    return next(c["slot"] for c in info["clusters"] if c["target"] == target)
+    return next(c["slot"] for c in info["slots"].rows() if c["target"] == target)
 
 
 def padding_slot(info: dict) -> int:
@@ -202,28 +203,14 @@ def test_teammates_observations_stay_in_their_space(layout, normalize):
 def free_info(
     clusters: list[tuple[int, tuple[int, int]]], position: tuple[int, int], belief: np.ndarray
 ) -> dict:
-    """A robot's info with live slots 0.. holding (cluster index, target) in that order."""
-    mask = np.zeros(4, np.int8)
-    mask[: len(clusters)] = 1
-    if not clusters:
-        mask[0] = 1
-    return {
-        "clusters": [
-            {
-                "slot": s,
-                "cluster": c,
-                "centroid": (float(t[0]), float(t[1])),
-                "target": t,
-                "size": 1,
-                "gain": 1.0,
-                "distance": float(np.hypot(t[0] - position[0], t[1] - position[1])),
-            }
-            for s, (c, t) in enumerate(clusters)
-        ],
-        "action_mask": mask,
-        "position": position,
-        "belief": belief,
-    }
+    """A robot's info with live slots 0.. holding (cluster index, target) in that order, their
+    path lengths by BFS over the belief's free cells (which the test keeps in the info)."""
+    reach = bfs_distances(belief == FREE, position)
+    live = [
+        live_slot(1.0, float(np.hypot(t[0] - position[0], t[1] - position[1])), int(reach[t]), t, c)
+        for c, t in clusters
+    ]
+    return info_with(live, position=position, belief=belief)
 
 
 @st.composite
@@ -262,7 +249,7 @@ def team_states(draw: st.DrawFn) -> tuple[dict[str, dict], dict[int, tuple[int, 
 def chosen_clusters(infos: dict[str, dict], actions: dict[str, int]) -> dict[str, int | None]:
     out = {}
     for agent, slot in actions.items():
-        match = [c["cluster"] for c in infos[agent]["clusters"] if c["slot"] == slot]
+        match = [c["cluster"] for c in infos[agent]["slots"].rows() if c["slot"] == slot]
         out[agent] = match[0] if match else None
     return out
 
@@ -273,7 +260,7 @@ def best_distinct_assignment(infos: dict[str, dict]) -> tuple[int, int]:
     options = []
     for info in infos.values():
         dist = bfs_distances(info["belief"] == FREE, info["position"])
-        options.append([(c["cluster"], int(dist[c["target"]])) for c in info["clusters"]])
+        options.append([(c["cluster"], int(dist[c["target"]])) for c in info["slots"].rows()])
     best = (0, 0)
     for combo in itertools.product(*[[None, *opts] for opts in options]):
         picked = [o for o in combo if o is not None]
@@ -293,7 +280,7 @@ def test_coordinated_assignment_never_duplicates_an_avoidable_target(state):
     clusters = chosen_clusters(infos, actions)
     for agent, slot in actions.items():
         assert infos[agent]["action_mask"][slot] == 1  # always a live slot (or idle slot 0)
-        assert (clusters[agent] is None) == (not infos[agent]["clusters"])
+        assert (clusters[agent] is None) == (not infos[agent]["slots"].rows())
     distinct, shortest = best_distinct_assignment(infos)
     picked = [c for c in clusters.values() if c is not None]
     assert len(set(picked)) == distinct  # as many robots on their own cluster as possible
@@ -304,7 +291,7 @@ def test_coordinated_assignment_never_duplicates_an_avoidable_target(state):
             if cluster is None:
                 continue
             info = infos[agent]
-            target = next(c["target"] for c in info["clusters"] if c["cluster"] == cluster)
+            target = next(c["target"] for c in info["slots"].rows() if c["cluster"] == cluster)
             lengths.append(int(bfs_distances(info["belief"] == FREE, info["position"])[target]))
         assert sum(lengths) == shortest  # and of the least total path length
 
@@ -363,9 +350,9 @@ def test_one_robot_in_a_real_episode_follows_the_shortest_path_rule(name):
     while env.agents:
         info = infos["robot_0"]
         action = policy.act_team(obs, infos)["robot_0"]
-        if info["clusters"]:
+        if info["slots"].rows():
             dist = bfs_distances(env.world.belief == FREE, info["position"])
-            lengths = {c["slot"]: dist[c["target"]] for c in info["clusters"]}
+            lengths = {c["slot"]: dist[c["target"]] for c in info["slots"].rows()}
             assert lengths[action] == min(lengths.values())
         obs, _, _, _, infos = env.step({"robot_0": action})
         steps += 1
@@ -446,11 +433,11 @@ def test_utility_discount_moves_the_second_robot_off_a_claimed_area():
     assert sorted(chosen_clusters(infos, wide).values()) == [0, 1]  # tiny range: no discount
 
 
-def test_team_heuristics_need_a_map_and_a_range():
+def test_team_heuristics_need_the_slot_tables_and_a_range():
     info = free_info([(0, (0, 2))], (0, 0), WALLED)
-    del info["belief"]
+    del info["slots"]
     for name in TEAM_POLICIES:
-        with pytest.raises(ValueError, match="belief"):
+        with pytest.raises(ValueError, match="slots"):
             make_policy(name).act_team({"a": None, "b": None}, {"a": info, "b": info})
     belief = np.full((1, 5), FREE, np.int8)
     infos = {
@@ -459,8 +446,6 @@ def test_team_heuristics_need_a_map_and_a_range():
     }
     with pytest.raises(ValueError, match="sensor range"):
         UtilityDiscount().act_team(dict.fromkeys(infos), infos)
-    with pytest.raises(ValueError, match="world"):
-        CoordinatedAssignment().attach(object())
     with pytest.raises(ValueError, match="beta"):
         UtilityDiscount(beta=-1.0)
     with pytest.raises(ValueError, match="sensor_range"):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import frontier_marl
-from frontier_marl.core.grid import FREE, OCCUPIED
+from frontier_marl.core.grid import FREE
 from frontier_marl.policies import (
     POLICIES,
     CallablePolicy,
@@ -19,28 +19,8 @@ from frontier_marl.policies import (
     RandomValid,
     make_policy,
 )
-
-
-def cluster(slot: int, gain: float, distance: float, target=(0, 0), size=None) -> dict:
-    return {
-        "slot": slot,
-        "cluster": slot,
-        "centroid": (float(target[0]), float(target[1])),
-        "target": target,
-        "size": int(gain) if size is None else size,
-        "gain": float(gain),
-        "distance": float(distance),
-    }
-
-
-def info_with(clusters: list[dict], n_slots: int = 4, position=(0, 0), **extra) -> dict:
-    mask = np.zeros(n_slots, dtype=np.int8)
-    for c in clusters:
-        mask[c["slot"]] = 1
-    if not clusters:
-        mask[0] = 1
-    return {"clusters": clusters, "action_mask": mask, "position": position, **extra}
-
+from tests.helpers import info_with, live_slot
+from tests.oracles import bfs
 
 # ----------------------------------------------------------------- greedy distance / gain
 
@@ -54,62 +34,53 @@ def test_first_slot_is_greedy_distance_when_slots_are_sorted():
     assert first.rewards == greedy.rewards
     unsorted = evaluate({"preset": "thesis-20x20"}, FirstSlot(), episodes=3)
     assert unsorted.rewards != first.rewards  # slot 0 is another cluster when unsorted
-    info = info_with([cluster(2, 9, 0.5), cluster(0, 1, 4.0)])
+    info = info_with([live_slot(9, 4.0), live_slot(1, 0.5)])
     assert FirstSlot().act(None, info) == 0
 
 
 def test_greedy_distance_picks_the_nearest_centroid():
-    info = info_with([cluster(0, 9, 4.0), cluster(1, 2, 1.5), cluster(2, 5, 3.0)])
+    info = info_with([live_slot(9, 4.0), live_slot(2, 1.5), live_slot(5, 3.0)])
     assert GreedyDistance().act(None, info) == 1
 
 
 def test_greedy_distance_ties_go_to_the_lowest_slot():
-    info = info_with([cluster(3, 1, 2.0), cluster(1, 9, 2.0), cluster(2, 5, 3.0)])
+    info = info_with([live_slot(5, 3.0), live_slot(1, 2.0), live_slot(9, 2.0)])
     assert GreedyDistance().act(None, info) == 1
 
 
 def test_greedy_gain_picks_the_largest_gain():
-    info = info_with([cluster(0, 3, 1.0), cluster(1, 2, 1.5), cluster(2, 7, 6.0)])
+    info = info_with([live_slot(3, 1.0), live_slot(2, 1.5), live_slot(7, 6.0)])
     assert GreedyGain().act(None, info) == 2
 
 
 def test_greedy_gain_ties_go_to_the_nearest_then_the_lowest_slot():
-    info = info_with([cluster(0, 7, 5.0), cluster(1, 2, 0.5), cluster(3, 7, 2.0)])
-    assert GreedyGain().act(None, info) == 3
-    info = info_with([cluster(2, 7, 2.0), cluster(1, 7, 2.0)])
+    info = info_with([live_slot(7, 5.0), live_slot(2, 0.5), live_slot(7, 2.0)])
+    assert GreedyGain().act(None, info) == 2
+    info = info_with([live_slot(1, 0.5), live_slot(7, 2.0), live_slot(7, 2.0)])
     assert GreedyGain().act(None, info) == 1
 
 
 @pytest.mark.parametrize("name", list(POLICIES))
 def test_no_live_cluster_gives_slot_0(name):
     policy = make_policy(name, seed=0)
-    assert policy.act(None, info_with([], belief=np.zeros((3, 3), np.int8))) == 0
+    assert policy.act(None, info_with([])) == 0
 
 
 # ----------------------------------------------------------------- cost-utility
 
-# 3 x 7 known map; a wall on row 1 (cols 0-5) separates the robot at (0, 0) from (2, 0):
-#   R . . . . . B        A: target (2, 0), Euclidean 2 away but 14 cells by path
-#   # # # # # # .        B: target (0, 6), 6 cells away
-#   A . . . . . .
-WALLED = np.full((3, 7), FREE, dtype=np.int8)
-WALLED[1, :6] = OCCUPIED
+# A wall between the robot and target A: A is 2 cells away by Euclid but 14 by path, B 6 and 6.
 
 
 def walled_info(gain_a: float, gain_b: float) -> dict:
     return info_with(
-        [cluster(0, gain_a, 2.0, target=(2, 0)), cluster(1, gain_b, 6.0, target=(0, 6))],
-        position=(0, 0),
-        belief=WALLED,
+        [live_slot(gain_a, 2.0, path_length=14), live_slot(gain_b, 6.0, path_length=6)]
     )
 
 
 def test_cost_utility_uses_path_length_not_euclidean_distance():
     info = walled_info(gain_a=4, gain_b=3)  # utilities 4/14 and 3/6
-    policy = CostUtility()
-    assert policy.path_lengths(info) == {0: 14, 1: 6}
-    assert policy.utilities(info) == pytest.approx({0: 4 / 14, 1: 0.5})
-    assert policy.act(None, info) == 1
+    np.testing.assert_allclose(CostUtility.utilities(info["slots"]), [4 / 14, 0.5])
+    assert CostUtility().act(None, info) == 1
     # the other heuristics prefer A (nearer by Euclid, larger gain)
     assert GreedyDistance().act(None, info) == 0
     assert GreedyGain().act(None, info) == 0
@@ -124,43 +95,45 @@ def test_cost_utility_ties_go_to_the_nearest():
     assert CostUtility().act(None, walled_info(gain_a=7, gain_b=3)) == 0
 
 
-def test_cost_utility_needs_a_map():
-    info = walled_info(4, 3)
-    del info["belief"]
-    with pytest.raises(ValueError, match="belief"):
-        CostUtility().act(None, info)
+def test_cost_utility_counts_a_path_of_zero_as_one():
+    info = info_with([live_slot(2, 0.0, path_length=0), live_slot(3, 2.0, path_length=2)])
+    np.testing.assert_allclose(CostUtility.utilities(info["slots"]), [2.0, 1.5])
+    assert CostUtility().act(None, info) == 0
 
 
-def test_cost_utility_attached_env_matches_explicit_belief():
+def test_heuristics_need_the_slot_table():
+    with pytest.raises(ValueError, match="slots"):
+        CostUtility().act(None, {"action_mask": np.ones(4, np.int8)})
+
+
+def test_cost_utility_in_a_real_episode_maximises_gain_over_the_bfs_path():
     env = frontier_marl.parallel_env(height=8, width=9, obstacle_prob=0.15)
-    attached = CostUtility()
-    attached.attach(env)
-    explicit = CostUtility()
+    policy = CostUtility()
     obs, infos = env.reset(seed=3)
     steps = 0
     while env.agents and steps < 15:
         info = infos["robot_0"]
-        action = attached.act(obs["robot_0"], info)
-        assert action == explicit.act(None, {**info, "belief": env.world.belief})
+        table = info["slots"]
+        dist = bfs(env.world.belief == FREE, info["position"])
+        lengths = [dist[tuple(table.target[s])] for s in range(table.live)]
+        np.testing.assert_array_equal(table.path_length[: table.live], lengths)
+        utility = table.gain[: table.live] / np.maximum(lengths, 1)
+        action = policy.act(obs["robot_0"], info)
+        assert utility[action] == utility.max()
         obs, _, _, _, infos = env.step({"robot_0": action})
         steps += 1
     assert steps > 3
-
-
-def test_cost_utility_attach_rejects_an_env_without_a_world():
-    with pytest.raises(ValueError, match="world"):
-        CostUtility().attach(object())
 
 
 # ----------------------------------------------------------------- random
 
 
 def test_random_draws_only_valid_slots_uniformly_and_reproducibly():
-    info = info_with([cluster(1, 1, 1.0), cluster(3, 1, 1.0)], n_slots=5)
+    info = info_with([live_slot(), live_slot()], n_slots=5)
     policy = RandomValid()
     policy.reset(7)
     draws = [policy.act(None, info) for _ in range(400)]
-    assert set(draws) == {1, 3}
+    assert set(draws) == {0, 1}
     assert 150 < draws.count(1) < 250
     again = make_policy("random", seed=7)
     assert [again.act(None, info) for _ in range(400)] == draws
@@ -177,8 +150,8 @@ def test_make_policy_lists_valid_names():
 
 def test_act_team_decides_for_every_robot_independently():
     infos = {
-        "robot_0": info_with([cluster(0, 1, 3.0), cluster(1, 1, 1.0)]),
-        "robot_1": info_with([cluster(0, 1, 0.5), cluster(2, 1, 1.0)]),
+        "robot_0": info_with([live_slot(1, 3.0), live_slot(1, 1.0)]),
+        "robot_1": info_with([live_slot(1, 0.5), live_slot(1, 1.0)]),
     }
     actions = GreedyDistance().act_team({"robot_0": None, "robot_1": None}, infos)
     assert actions == {"robot_0": 1, "robot_1": 0}

@@ -34,9 +34,9 @@ def diagnose(model_dir: Path, episodes: int) -> dict[str, float]:
         while not done:
             action, _ = loaded.model.predict(obs, deterministic=True)
             slot = int(action)
-            chosen = next((c["target"] for c in info["clusters"] if c["slot"] == slot), None)
+            chosen = next((c["target"] for c in info["slots"].rows() if c["slot"] == slot), None)
             obs, _, terminated, truncated, info = env.step(slot)
-            still_live = chosen in {c["target"] for c in info["clusters"]}
+            still_live = chosen in {c["target"] for c in info["slots"].rows()}
             history.append((chosen, still_live))
             done = terminated or truncated
         counts[f"end: {info['end_reason']}"] += 1

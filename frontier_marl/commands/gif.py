@@ -57,12 +57,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def render_frame(env: Any, infos: dict[str, dict[str, Any]], cell_px: int) -> np.ndarray:
+def render_frame(env: Any, cell_px: int) -> np.ndarray:
     """An RGB frame of ``env``'s current state at ``cell_px`` pixels per cell (the same
     picture as ``env.render()`` in ``rgb_array`` mode, which is fixed at 12 px)."""
-    from frontier_marl.envs.common import frame
+    from frontier_marl.envs.rendering import frame
 
-    return frame(env.unwrapped.mdp, list(infos.values()), "rgb_array", cell_px=cell_px)
+    return frame(env.unwrapped.mdp, "rgb_array", cell_px=cell_px)
 
 
 def record_episode(
@@ -81,7 +81,7 @@ def record_episode(
         policy = make_policy(policy_name, seed)
         policy.attach(env)
         observations, infos = env.reset(seed=seed)
-        frames = [render_frame(env, infos, cell_px)]
+        frames = [render_frame(env, cell_px)]
         returns = dict.fromkeys(env.agents, 0.0)
         steps = 0
         reason = ""
@@ -91,7 +91,7 @@ def record_episode(
             for agent, reward in rewards.items():
                 returns[agent] += reward
             steps += 1
-            frames.append(render_frame(env, infos, cell_px))
+            frames.append(render_frame(env, cell_px))
             reason = next(iter(infos.values()))["end_reason"]
         if env.agents:
             reason = "max_steps"

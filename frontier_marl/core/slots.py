@@ -16,6 +16,7 @@ Rules (open choices of the thesis, documented in docs/thesis-mapping.md):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -24,12 +25,25 @@ from frontier_marl.core.frontiers import Clusters
 from frontier_marl.core.grid import FREE
 from frontier_marl.core.planning import distance_field
 
+_ARRAYS = (
+    "cluster",
+    "valid",
+    "centroid",
+    "target",
+    "distance",
+    "size",
+    "gain",
+    "path_length",
+    "mask",
+)
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, eq=False)
 class SlotTable:
     """One robot's slots. Arrays have length ``n_slots``; padding rows hold zeros and -1.
 
-    Read-only by convention: a table is built once per decision and never changed.
+    A table is built once per decision and shared (by the observation, the info and the action
+    mask), so its arrays are read-only.
     """
 
     cluster: np.ndarray  # int (n,), cluster index or -1 for padding
@@ -48,6 +62,45 @@ class SlotTable:
         if not self.live:
             mask[0] = 1  # no live cluster: slot 0 is the idle action
         object.__setattr__(self, "mask", mask)
+        for array in (
+            self.cluster,
+            self.valid,
+            self.centroid,
+            self.target,
+            self.distance,
+            self.size,
+            self.gain,
+            self.path_length,
+            mask,
+        ):
+            array.flags.writeable = False
+
+    def __eq__(self, other: object) -> bool:
+        """Equal when every field is: same live count and identical arrays."""
+        if not isinstance(other, SlotTable):
+            return NotImplemented
+        return self.live == other.live and all(
+            np.array_equal(getattr(self, name), getattr(other, name)) for name in _ARRAYS
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # mutable-looking arrays: not hashable
+
+    def rows(self) -> list[dict[str, Any]]:
+        """The live slots as plain dicts (slot, cluster, centroid, target, distance,
+        path_length, size, gain), for reading and printing rather than for speed."""
+        return [
+            {
+                "slot": slot,
+                "cluster": int(self.cluster[slot]),
+                "centroid": (float(self.centroid[slot, 0]), float(self.centroid[slot, 1])),
+                "target": (int(self.target[slot, 0]), int(self.target[slot, 1])),
+                "distance": float(self.distance[slot]),
+                "path_length": int(self.path_length[slot]),
+                "size": int(self.size[slot]),
+                "gain": float(self.gain[slot]),
+            }
+            for slot in range(self.live)
+        ]
 
     def action_mask(self) -> np.ndarray:
         """int8 mask of the actions worth taking: the live slots, or slot 0 (idle) if none."""

@@ -11,7 +11,8 @@ from gymnasium import spaces
 from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.core.world import World
 from frontier_marl.engine import ExplorationMDP
-from frontier_marl.envs.common import RENDER_MODES, Renderer
+from frontier_marl.envs.infos import build_infos, check_info_level
+from frontier_marl.envs.rendering import RENDER_MODES, Renderer
 
 
 class FrontierExploreEnv(gym.Env):
@@ -27,9 +28,14 @@ class FrontierExploreEnv(gym.Env):
     metadata = {"render_modes": RENDER_MODES, "render_fps": 4}
 
     def __init__(
-        self, preset: str | None = "thesis-20x20", render_mode: str | None = None, **kwargs: Any
+        self,
+        preset: str | None = "thesis-20x20",
+        render_mode: str | None = None,
+        info: str = "full",
+        **kwargs: Any,
     ) -> None:
         self._renderer = Renderer(render_mode, self.metadata["render_fps"])
+        self._info_level = check_info_level(info)
         config = make_config(preset, **kwargs)
         if config.n_agents != 1:
             raise ValueError(
@@ -41,7 +47,6 @@ class FrontierExploreEnv(gym.Env):
         self._mdp = ExplorationMDP(config)
         self.observation_space = self._mdp.encoder.space
         self.action_space = spaces.Discrete(config.n_slots)
-        self._last_infos: list[dict[str, Any]] | None = None
 
     @property
     def world(self) -> World:
@@ -58,15 +63,13 @@ class FrontierExploreEnv(gym.Env):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         super().reset(seed=seed)
-        observations, infos = self._mdp.reset(self.np_random)
-        self._last_infos = infos
+        observations = self._mdp.reset(self.np_random)
         if self.render_mode == "human":
             self.render()
-        return observations[0], infos[0]
+        return observations[0], build_infos(self._mdp, None, self._info_level)[0]
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         result = self._mdp.step([action])
-        self._last_infos = result.infos
         if self.render_mode == "human":
             self.render()
         return (
@@ -74,7 +77,7 @@ class FrontierExploreEnv(gym.Env):
             float(result.rewards[0]),
             result.terminated,
             result.truncated,
-            result.infos[0],
+            build_infos(self._mdp, result, self._info_level)[0],
         )
 
     def action_masks(self) -> np.ndarray:
@@ -82,7 +85,7 @@ class FrontierExploreEnv(gym.Env):
         return self._mdp.action_masks()[0].astype(bool)
 
     def render(self) -> Any:
-        return self._renderer.render(self._mdp, self._last_infos)
+        return self._renderer.render(self._mdp)
 
     def close(self) -> None:
         self._renderer.close()

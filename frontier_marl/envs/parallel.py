@@ -11,7 +11,8 @@ from pettingzoo import ParallelEnv
 from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.core.world import World
 from frontier_marl.engine import ExplorationMDP
-from frontier_marl.envs.common import RENDER_MODES, Renderer
+from frontier_marl.envs.infos import build_infos, check_info_level
+from frontier_marl.envs.rendering import RENDER_MODES, Renderer
 
 
 class FrontierParallelEnv(ParallelEnv):
@@ -42,16 +43,18 @@ class FrontierParallelEnv(ParallelEnv):
     robot has a reachable frontier left; truncated by the step limit, by ``no_progress_limit``
     steps without a new cell, or (Reward 1) by a padding action.
 
-    **Arguments.** ``preset`` (``thesis-20x20`` or ``thesis-30x30``), ``render_mode``, and any
-    field of :class:`~frontier_marl.config.EnvConfig` / ``ObservationConfig`` /
-    ``RewardConfig`` as a flat keyword (``config=EnvConfig(...)`` also works). Every value is
-    validated at construction.
+    **Arguments.** ``preset`` (``thesis-20x20`` or ``thesis-30x30``), ``render_mode``,
+    ``info`` (``full`` or ``minimal``), and any field of
+    :class:`~frontier_marl.config.EnvConfig` / ``ObservationConfig`` / ``RewardConfig`` as a
+    flat keyword (``config=EnvConfig(...)`` also works). Every value is validated at
+    construction.
 
-    **Info.** Per agent: ``explored_fraction``, ``coverage`` (of the reachable free region),
-    ``new_cells``, ``action_mask``, ``clusters`` (slot, cluster, centroid, target, size, gain,
-    distance for each live slot), ``path`` (cells occupied this step, start included),
+    **Info.** Per agent (:mod:`frontier_marl.envs.infos`): ``explored_fraction``,
+    ``coverage`` (of the reachable free region), ``new_cells``, ``action_mask``, ``slots`` (the
+    robot's typed slot table), ``path`` (cells occupied this step, start included),
     ``target``, ``position``, ``travelled``, ``padding``, ``oscillation``, ``step``,
-    ``end_reason``; a ``StepInfo`` dict whose deep copy is shallow (treat it as read-only).
+    ``end_reason``; ``info="minimal"`` keeps only the scalars training needs and the mask. A
+    ``StepInfo`` dict whose deep copy is shallow (treat it as read-only).
 
     **Version history.** v0: first release.
     """
@@ -64,9 +67,14 @@ class FrontierParallelEnv(ParallelEnv):
     }
 
     def __init__(
-        self, preset: str | None = "thesis-20x20", render_mode: str | None = None, **kwargs: Any
+        self,
+        preset: str | None = "thesis-20x20",
+        render_mode: str | None = None,
+        info: str = "full",
+        **kwargs: Any,
     ) -> None:
         self._renderer = Renderer(render_mode, self.metadata["render_fps"])
+        self._info_level = check_info_level(info)
         self.config: EnvConfig = make_config(preset, **kwargs)
         self.render_mode = render_mode
         self._mdp = ExplorationMDP(self.config)
@@ -78,7 +86,6 @@ class FrontierParallelEnv(ParallelEnv):
         self.action_spaces = dict.fromkeys(self.possible_agents, self._act_space)
         self.state_space = spaces.Box(-1, 1, self.config.shape, dtype=np.int8)
         self._rng: np.random.Generator | None = None
-        self._last_infos: list[dict[str, Any]] | None = None
 
     def observation_space(self, agent: str) -> spaces.Space[Any]:
         return self._obs_space
@@ -103,9 +110,9 @@ class FrontierParallelEnv(ParallelEnv):
         if seed is not None or self._rng is None:
             self._rng = np.random.default_rng(seed)
             self._act_space.seed(None if seed is None else seed + 1)
-        observations, infos = self._mdp.reset(self._rng)
+        observations = self._mdp.reset(self._rng)
+        infos = build_infos(self._mdp, None, self._info_level)
         self.agents = list(self.possible_agents)
-        self._last_infos = infos
         if self.render_mode == "human":
             self.render()
         return dict(zip(self.agents, observations, strict=True)), dict(
@@ -132,12 +139,11 @@ class FrontierParallelEnv(ParallelEnv):
             )
         agents = self.agents
         result = self._mdp.step([actions[agent] for agent in agents])
-        self._last_infos = result.infos
         observations = dict(zip(agents, result.observations, strict=True))
         rewards = {agent: float(r) for agent, r in zip(agents, result.rewards, strict=True)}
         terminations = dict.fromkeys(agents, result.terminated)
         truncations = dict.fromkeys(agents, result.truncated)
-        infos = dict(zip(agents, result.infos, strict=True))
+        infos = dict(zip(agents, build_infos(self._mdp, result, self._info_level), strict=True))
         if result.terminated or result.truncated:
             self.agents = []
         if self.render_mode == "human":
@@ -145,7 +151,7 @@ class FrontierParallelEnv(ParallelEnv):
         return observations, rewards, terminations, truncations, infos
 
     def render(self) -> Any:
-        return self._renderer.render(self._mdp, self._last_infos)
+        return self._renderer.render(self._mdp)
 
     def close(self) -> None:
         self._renderer.close()

@@ -65,8 +65,9 @@ class TimeLimitInfo(BaseParallelWrapper):
 
 
 def make_parallel_env(env_kwargs: dict[str, Any], mark_truncations: bool = True) -> TimeLimitInfo:
-    """The wrapped ParallelEnv for ``env_kwargs`` (flat keywords of ``make_config``)."""
-    return TimeLimitInfo(FrontierParallelEnv(**env_kwargs), mark_truncations)
+    """The wrapped ParallelEnv for ``env_kwargs`` (flat keywords of ``make_config``), with the
+    minimal infos (training reads only the end reason, the mask and the scalars)."""
+    return TimeLimitInfo(FrontierParallelEnv(info="minimal", **env_kwargs), mark_truncations)
 
 
 def make_vec_env(

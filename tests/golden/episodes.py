@@ -142,18 +142,20 @@ def _feed(digest: Any, value: Any) -> None:
 
 def slot_rows(info: Mapping[str, Any]) -> list[tuple[Any, ...]]:
     """The live slots of one robot's info: (slot, cluster, centroid, target, size, gain,
-    distance) each, with centroid and target as (row, col) tuples."""
+    distance) each, with centroid and target as (row, col) tuples. (Before the typed step
+    these were the info's ``clusters`` dicts; the rows are the same.)"""
+    table = info["slots"]
     return [
         (
-            int(c["slot"]),
-            int(c["cluster"]),
-            tuple(float(v) for v in c["centroid"]),
-            tuple(int(v) for v in c["target"]),
-            int(c["size"]),
-            float(c["gain"]),
-            float(c["distance"]),
+            slot,
+            int(table.cluster[slot]),
+            tuple(float(v) for v in table.centroid[slot]),
+            tuple(int(v) for v in table.target[slot]),
+            int(table.size[slot]),
+            float(table.gain[slot]),
+            float(table.distance[slot]),
         )
-        for c in info["clusters"]
+        for slot in range(table.live)
     ]
 
 

@@ -1,4 +1,4 @@
-"""Rendering shared by the adapters: a frame of the MDP's current state in any render mode."""
+"""Rendering for the adapters: a frame of the MDP's current state in any render mode."""
 
 from __future__ import annotations
 
@@ -17,14 +17,9 @@ def check_render_mode(render_mode: str | None) -> None:
         raise ValueError(f"render_mode must be one of {RENDER_MODES} or None, got {render_mode!r}")
 
 
-def frame(
-    mdp: ExplorationMDP,
-    last_infos: list[dict[str, Any]] | None,
-    mode: str,
-    cell_px: int = 12,
-) -> Any:
+def frame(mdp: ExplorationMDP, mode: str, cell_px: int = 12) -> Any:
     """An RGB frame (``rgb_array``/``human``, ``cell_px`` pixels per cell) or a text map
-    (``ansi``) of the current state."""
+    (``ansi``) of the current state, with the last step's paths and targets."""
     world = mdp.world
     if world is None:
         raise RuntimeError("render() called before reset()")
@@ -32,11 +27,12 @@ def frame(
     labels = clusters.labels()
     if mode == "ansi":
         return render_ansi(world.belief, world.positions, labels)
-    paths = [info["path"] for info in last_infos] if last_infos else None
-    targets = np.full((world.n_agents, 2), -1, dtype=np.int64)
-    for agent, info in enumerate(last_infos or []):
-        if info.get("target") is not None:
-            targets[agent] = info["target"]
+    last = mdp.last
+    if last is None:  # right after reset: no path, no target
+        paths = [cell[None, :] for cell in world.positions]
+        targets = np.full((world.n_agents, 2), -1, dtype=np.int64)
+    else:
+        paths, targets = last.move.paths, last.targets
     return render_rgb(
         world.true_grid,
         world.belief,
@@ -58,10 +54,10 @@ class Renderer:
         self.fps = fps
         self._viewer: Any = None
 
-    def render(self, mdp: ExplorationMDP, last_infos: list[dict[str, Any]] | None) -> Any:
+    def render(self, mdp: ExplorationMDP) -> Any:
         if self.mode is None:
             return None
-        image = frame(mdp, last_infos, self.mode)
+        image = frame(mdp, self.mode)
         if self.mode != "human":
             return image
         if self._viewer is None:
