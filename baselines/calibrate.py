@@ -57,10 +57,14 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.evaluation import evaluate
-from frontier_marl.policies import make_policy
+from frontier_marl.evaluation import evaluate, make_policy
+from frontier_marl.thesis import HEURISTIC_BASELINES
 
-THESIS = {"greedy-distance": (16.48, 1.78), "greedy-gain": (15.01, 1.12)}
+THESIS = {
+    policy: figure
+    for (preset, mode, policy), figure in HEURISTIC_BASELINES.items()
+    if (preset, mode) == ("thesis-20x20", "static")
+}
 POLICIES = tuple(THESIS)
 
 #: Fixed geometry of the calibrated setting (not searched).

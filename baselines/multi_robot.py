@@ -17,7 +17,7 @@ episode ends when the whole reachable free region is known), ``max_steps=5000`` 
 Writes to ``--out`` (default ``baselines/results/multi_robot``): ``results.json`` (every row, with
 per-episode records; the coverage curves only with ``--curves``), ``comparison.json`` (the
 paired comparison with greedy distance), ``summary.md`` (the tables of docs/multi-robot.md) and
-one PNG per map (:func:`frontier_marl.plots.plot_team_comparison`).
+one PNG per map (:func:`frontier_marl.evaluation.plots.plot_team_comparison`).
 
 The shared-parameter DQN (``training/team_30x30.toml``, ``training/team_rooms64.toml``) is
 evaluated with ``--dqn-30x30 RUN_DIR --dqn-rooms64 RUN_DIR`` (either or both): each model on its
@@ -30,7 +30,7 @@ outputs are not touched)::
 
 Other policies plug in through
 :func:`run_experiment`'s ``policies`` argument: a dict of name -> zero-argument factory of a
-:class:`frontier_marl.policies.Policy`, evaluated with the env kwargs of each setting.
+:class:`frontier_marl.evaluation.Policy`, evaluated with the env kwargs of each setting.
 """
 
 from __future__ import annotations
@@ -45,11 +45,10 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.commands.baselines import dumps_rows
-from frontier_marl.evaluation import evaluate
+from frontier_marl.evaluation import Policy, evaluate, make_policy
+from frontier_marl.evaluation.plots import plot_team_comparison, team_value
 from frontier_marl.example_maps import example_map_path
-from frontier_marl.plots import plot_team_comparison, team_value
-from frontier_marl.policies import Policy, make_policy
+from frontier_marl.workflows.baselines import dumps_rows
 
 OUT = Path(__file__).resolve().parent / "results" / "multi_robot"
 HEURISTICS = ("greedy-distance", "coordinated-assignment", "utility-discount")
@@ -110,7 +109,7 @@ def dqn_factory(run: Path, setting_kwargs: Mapping[str, Any], robots: Sequence[i
     """A zero-argument factory of the deterministic ``dqn-shared`` policy of run folder ``run``,
     after checking that the model fits the setting's env with every team size."""
     from frontier_marl.config import make_config
-    from frontier_marl.policies import ModelPolicy
+    from frontier_marl.evaluation import ModelPolicy
     from frontier_marl.training.evaluate_model import check_model_env, load_model
 
     loaded = load_model(run)

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from frontier_marl.cli import main as cli_main
-from frontier_marl.commands.baselines import DEFAULT_POLICIES, format_table
+from frontier_marl.workflows.baselines import DEFAULT_POLICIES, format_table
 
 SETTINGS = [
     ("thesis-20x20", "static"),

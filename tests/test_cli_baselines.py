@@ -7,7 +7,7 @@ import json
 import pytest
 
 from frontier_marl.cli import main
-from frontier_marl.commands.baselines import parse_set_options, parse_value
+from frontier_marl.commands.arguments import parse_set_options, parse_value
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 SMALL = [

@@ -1,4 +1,4 @@
-"""Tests for frontier_marl.evaluation and frontier_marl.metrics."""
+"""Tests for frontier_marl.evaluation and frontier_marl.evaluation.metrics."""
 
 from __future__ import annotations
 
@@ -9,8 +9,12 @@ import numpy as np
 import pytest
 
 import frontier_marl
-from frontier_marl.evaluation import THESIS_FIGURES, evaluate, thesis_figure
-from frontier_marl.metrics import (
+from frontier_marl.evaluation import (
+    CallablePolicy,
+    evaluate,
+    make_policy,
+)
+from frontier_marl.evaluation.metrics import (
     action_shares,
     cells_to_coverage,
     coverage_curve,
@@ -19,7 +23,7 @@ from frontier_marl.metrics import (
     overlap_ratio,
     resample_curve,
 )
-from frontier_marl.policies import CallablePolicy, make_policy
+from frontier_marl.thesis import HEURISTIC_BASELINES, heuristic_baseline
 
 # A tiny map. explore_threshold < 1 keeps episodes from running out of frontiers, which
 # currently crashes the env (see test_fully_known_map_gives_exact_numbers).
@@ -33,7 +37,7 @@ TINY = {
 
 
 def nearest(info: dict) -> int:
-    """Greedy distance, written independently of frontier_marl.policies."""
+    """Greedy distance, written independently of frontier_marl.evaluation."""
     clusters = info["slots"].rows()
     if not clusters:
         return 0
@@ -198,10 +202,10 @@ def test_invalid_arguments(kwargs, match):
 
 
 def test_thesis_figures():
-    assert thesis_figure("thesis-20x20", "static", "greedy-distance") == (16.48, 1.78)
-    assert thesis_figure("thesis-20x20", "static", "greedy-gain") == (15.01, 1.12)
-    assert thesis_figure("thesis-30x30", "static", "greedy-gain") is None
-    assert len(THESIS_FIGURES) == 2
+    assert heuristic_baseline("thesis-20x20", "static", "greedy-distance") == (16.48, 1.78)
+    assert heuristic_baseline("thesis-20x20", "static", "greedy-gain") == (15.01, 1.12)
+    assert heuristic_baseline("thesis-30x30", "static", "greedy-gain") is None
+    assert len(HEURISTIC_BASELINES) == 2
 
 
 # ----------------------------------------------------------------- metrics

@@ -21,15 +21,15 @@ import frontier_marl
 from frontier_marl.cli import main
 from frontier_marl.config import make_config
 from frontier_marl.core.grid import FREE, OCCUPIED
-from frontier_marl.evaluation import evaluate
-from frontier_marl.example_maps import example_map_path
-from frontier_marl.metrics import makespan_curve, overlap_ratio
-from frontier_marl.policies import (
+from frontier_marl.evaluation import (
     TEAM_POLICIES,
     CoordinatedAssignment,
     UtilityDiscount,
+    evaluate,
     make_policy,
 )
+from frontier_marl.evaluation.metrics import makespan_curve, overlap_ratio
+from frontier_marl.example_maps import example_map_path
 from frontier_marl.rewards import StepEvents, step_outcome
 from tests.helpers import info_with, live_slot
 from tests.oracles import bfs as bfs_distances
@@ -697,7 +697,7 @@ def test_multi_robot_experiment_script_runs(tmp_path):
     overlap = entries[0]["overlap"]
     assert overlap["wins"] + overlap["ties"] + overlap["losses"] == 2
     assert "coordinated-assignment" in module["comparison_table"](entries)
-    from frontier_marl.plots import plot_team_comparison
+    from frontier_marl.evaluation.plots import plot_team_comparison
 
     plot_team_comparison(rows, tmp_path / "tiny.png", title="tiny")
     assert (tmp_path / "tiny.png").read_bytes()[:4] == b"\x89PNG"

@@ -1,4 +1,4 @@
-"""Several training runs in worker processes (frontier_marl.training.parallel).
+"""Several training runs in worker processes (frontier_marl.training.workers).
 
 Budgets are tiny (a 10 x 10 map, a few thousand steps); nothing here checks learning quality.
 """
@@ -19,7 +19,7 @@ pytest.importorskip("supersuit")
 
 from frontier_marl.training.checkpoints import list_checkpoints  # noqa: E402
 from frontier_marl.training.experiment import experiment_from_dict  # noqa: E402
-from frontier_marl.training.parallel import TrainJob, train_runs  # noqa: E402
+from frontier_marl.training.workers import TrainJob, train_runs  # noqa: E402
 
 
 def tiny(seed: int, steps: int = 1500) -> object:

@@ -1,4 +1,4 @@
-"""Tests for frontier_marl.policies: each heuristic on hand-made infos, and on the real envs."""
+"""Tests for frontier_marl.evaluation: each heuristic on hand-made infos, and on the real envs."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 
 import frontier_marl
 from frontier_marl.core.grid import FREE
-from frontier_marl.policies import (
+from frontier_marl.evaluation import (
     POLICIES,
     CallablePolicy,
     CostUtility,

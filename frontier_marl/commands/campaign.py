@@ -33,7 +33,7 @@ def _positive_float(text: str) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.baselines import int_list, positive_int
+    from frontier_marl.commands.arguments import int_list, positive_int
 
     parser.add_argument(
         "--configs",
@@ -103,9 +103,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.campaign import RayNotInstalledError, run_campaign
-    from frontier_marl.commands.baselines import fail
-    from frontier_marl.training.results import format_markdown
+    from frontier_marl.commands.arguments import fail
+    from frontier_marl.workflows.campaign import RayNotInstalledError, run_campaign
+    from frontier_marl.workflows.results import format_markdown
 
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     try:

@@ -24,7 +24,7 @@ from frontier_marl.config import PRESETS
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.baselines import non_negative_int, positive_int
+    from frontier_marl.commands.arguments import non_negative_int, positive_int
 
     parser.add_argument(
         "model",
@@ -100,7 +100,7 @@ def _fail(message: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.commands.baselines import parse_policies, parse_set_options
+    from frontier_marl.commands.arguments import parse_policies, parse_set_options
     from frontier_marl.training.evaluate_model import (
         evaluate_model,
         evaluation_env_config,

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.commands.baselines import (
+from frontier_marl.commands.arguments import (
     add_env_arguments,
     env_kwargs_from_args,
     fail,
@@ -25,7 +25,7 @@ from frontier_marl.commands.baselines import (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.policies import POLICIES
+    from frontier_marl.evaluation import POLICIES
 
     parser.add_argument(
         "--policy",
@@ -74,7 +74,7 @@ def record_episode(
 ) -> tuple[list[np.ndarray], float, int, str]:
     """Frames (reset included), team-mean return, decision steps and end reason."""
     import frontier_marl
-    from frontier_marl.policies import make_policy
+    from frontier_marl.evaluation import make_policy
 
     env = frontier_marl.parallel_env(render_mode="rgb_array", **env_kwargs)
     try:

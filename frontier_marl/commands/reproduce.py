@@ -28,8 +28,8 @@ from pathlib import Path
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.baselines import int_list, positive_int
-    from frontier_marl.reproduce import DEFAULT_SEEDS
+    from frontier_marl.commands.arguments import int_list, positive_int
+    from frontier_marl.workflows.reproduce import DEFAULT_SEEDS
 
     parser.add_argument(
         "--steps",
@@ -130,8 +130,8 @@ def _print_summary(result: object) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.commands.baselines import fail
-    from frontier_marl.reproduce import format_comparison_markdown, reproduce
+    from frontier_marl.commands.arguments import fail
+    from frontier_marl.workflows.reproduce import format_comparison_markdown, reproduce
 
     try:
         result = reproduce(

@@ -22,7 +22,7 @@ from typing import Any
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.baselines import non_negative_int, positive_int
+    from frontier_marl.commands.arguments import non_negative_int, positive_int
 
     parser.add_argument(
         "config",

@@ -1,7 +1,7 @@
 """Evaluation of a trained model with the thesis protocol, beside a heuristic.
 
 The episodes are run by :func:`frontier_marl.evaluation.evaluate` (one protocol for models and
-heuristics); the SB3 model acts through :class:`frontier_marl.policies.ModelPolicy` with
+heuristics); the SB3 model acts through :class:`frontier_marl.evaluation.ModelPolicy` with
 ``deterministic=True`` (epsilon = 0). Before any episode the model is checked against the env
 (:func:`~frontier_marl.training.metadata.check_compatible`).
 """
@@ -122,8 +122,7 @@ def evaluate_model(
     (one row per heuristic), ``rows`` (all rows, model first), the env config and the model
     file. Rows are :meth:`EvaluationResult.to_dict` outputs (per-episode curves included).
     """
-    from frontier_marl.evaluation import evaluate
-    from frontier_marl.policies import ModelPolicy, make_policy
+    from frontier_marl.evaluation import ModelPolicy, evaluate, make_policy
 
     check_model_env(loaded, cfg)
     env_kwargs = {"config": cfg}

@@ -34,17 +34,10 @@ from typing import Any
 
 from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
+from frontier_marl.thesis import DQN_HYPERPARAMETERS
 
-#: The thesis's final DQN hyperparameters (SPEC section 5); everything else is SB3's default.
-THESIS_DQN: dict[str, Any] = {
-    "learning_rate": 5e-5,
-    "exploration_fraction": 0.7,
-    "exploration_final_eps": 0.05,
-    "batch_size": 64,
-    "buffer_size": 50_000,
-    "target_update_interval": 500,
-    "train_freq": 4,
-}
+#: The thesis's final DQN hyperparameters; everything else is SB3's default.
+THESIS_DQN = DQN_HYPERPARAMETERS
 
 #: DQN arguments the pipeline sets itself (seeding goes through set_random_seed, see DESIGN).
 _RESERVED_DQN = {

@@ -66,8 +66,7 @@ class BestPolicyKeeper:
             shutil.rmtree(self.best_dir)
 
     def __call__(self, model: Any) -> float:
-        from frontier_marl.evaluation import evaluate
-        from frontier_marl.policies import ModelPolicy
+        from frontier_marl.evaluation import ModelPolicy, evaluate
 
         result = evaluate(
             {"config": self.cfg},

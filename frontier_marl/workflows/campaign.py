@@ -3,7 +3,7 @@
 Each Ray Tune trial is one training run: :func:`run_trial` calls the same
 :func:`frontier_marl.training.train.train` as ``frontier-marl train`` (``torch_threads=1``, no
 progress bar) into its own run folder ``OUT/runs/<config>/seed<S>_steps<N>`` and reports the
-run's summary row (:func:`frontier_marl.training.results.summary_row`). The driver collects
+run's summary row (:func:`frontier_marl.workflows.results.summary_row`). The driver collects
 the rows into ``OUT/campaign.md``, ``campaign.csv`` and ``campaign.json``.
 
 The experiments are read and validated by the driver and sent to the trials as dicts, so the
@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.training.results import SUMMARY_COLUMNS, sort_rows, summary_row, write_table
+from frontier_marl.workflows.results import SUMMARY_COLUMNS, sort_rows, summary_row, write_table
 
 RAY_HINT = 'Ray Tune is not installed: pip install "frontier-marl[ray]"'
 
-#: Extra columns of a campaign row (after :data:`~frontier_marl.training.results.SUMMARY_COLUMNS`).
+#: Extra columns of a campaign row (after :data:`~frontier_marl.workflows.results.SUMMARY_COLUMNS`).
 TRIAL_COLUMNS: tuple[str, ...] = ("status", "reused", "trial_wall_time_s", "node", "error")
 
 
@@ -136,8 +136,8 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
     """
     from frontier_marl.training.checkpoints import list_checkpoints
     from frontier_marl.training.experiment import experiment_from_dict
-    from frontier_marl.training.results import run_summary, training_wall_time
     from frontier_marl.training.train import resume_experiment, train
+    from frontier_marl.workflows.results import run_summary, training_wall_time
 
     started = time.perf_counter()
     run_dir = Path(spec.run_dir)

@@ -2,12 +2,12 @@
 
 :func:`reproduce` trains ``training/config01.toml`` (thesis-20x20, static map, Reward 2) for
 each of ``seeds`` (default 0, 1, 2; all at once in worker processes, see
-:mod:`frontier_marl.training.parallel`) with :func:`frontier_marl.training.train.train`, whose
+:mod:`frontier_marl.training.workers`) with :func:`frontier_marl.training.train.train`, whose
 final evaluation is the thesis protocol (deterministic, ``episodes`` episodes with reset seeds
 ``0 .. episodes-1``) of the final model and, with the config's validation, of the
 best-validated policy (the one the table reports, the final model beside it); runs the
 heuristic baselines on the same env and the same episodes with
-:func:`frontier_marl.commands.baselines.run_baselines`; and writes, under ``out``::
+:func:`frontier_marl.workflows.baselines.run_baselines`; and writes, under ``out``::
 
     OUT/comparison.md, comparison.json     ours beside the thesis's figures (SPEC section 6):
                                            the seeds' policies pooled, each seed, the final
@@ -35,10 +35,11 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.metrics import action_shares, mean_std
+from frontier_marl.evaluation.metrics import action_shares, mean_std
+from frontier_marl.thesis import CONFIG01_MIN_MEAN as MIN_MEAN
+from frontier_marl.thesis import DQN_RESULTS
 from frontier_marl.training.evaluate_model import degeneracy
-from frontier_marl.training.results import (
-    THESIS_DQN_RESULTS,
+from frontier_marl.workflows.results import (
     format_shares,
     summary_row,
     training_wall_time,
@@ -54,7 +55,6 @@ HEURISTICS: tuple[str, ...] = ("greedy-distance", "greedy-gain", "cost-utility",
 GENUINE_MAX_SHARE = 0.70
 GENUINE_MIN_SHARE = 0.02
 GENUINE_MIN_ACTIONS = 3
-MIN_MEAN = round(15.55 - 2.45, 2)
 
 #: Columns of the comparison table: (key, header).
 COLUMNS: tuple[tuple[str, str], ...] = (
@@ -285,9 +285,9 @@ def reproduce(
     """Train every seed (``jobs`` at a time, default all), evaluate and compare (see the
     module docstring). Raises ``ValueError`` on bad input or when ``out`` already holds a run
     and ``resume`` is false; nothing is trained then."""
-    from frontier_marl.commands.baselines import dumps_rows, run_baselines
-    from frontier_marl.training.parallel import train_runs
     from frontier_marl.training.train import write_json
+    from frontier_marl.training.workers import train_runs
+    from frontier_marl.workflows.baselines import dumps_rows, run_baselines
 
     steps = _check_int("steps", steps, 1)
     seeds = _check_seeds(seeds)
@@ -352,8 +352,8 @@ def _train_job(
     """The training job of one seed: a fresh run, or the run in ``out`` to resume."""
     from frontier_marl.training.checkpoints import find_checkpoint, list_checkpoints
     from frontier_marl.training.experiment import load_experiment
-    from frontier_marl.training.parallel import TrainJob
     from frontier_marl.training.train import resume_experiment
+    from frontier_marl.training.workers import TrainJob
 
     experiment = load_experiment(
         config, [f"train.{k}={v}" for k, v in {**settings, "seed": seed}.items()]
@@ -399,7 +399,7 @@ def comparison_table(
     name = experiment.name
     cfg = experiment.env_config()
     episodes = experiment.train.eval_episodes
-    thesis_dqn = THESIS_DQN_RESULTS.get(name)
+    thesis_dqn = DQN_RESULTS.get(name)
     # With validation (train.validate_every) each run reports its best-validated policy,
     # chosen on held-out episodes, never the protocol's; the final models are shown below.
     reported = [reported_evaluation(t) for t in trained]
@@ -511,7 +511,7 @@ def _figures(
     trained: Sequence[Any],
     name: str,
 ) -> dict[str, Path]:
-    from frontier_marl.plots import plot_baselines
+    from frontier_marl.evaluation.plots import plot_baselines
     from frontier_marl.training.callbacks import read_metrics
     from frontier_marl.training.plots import plot_action_comparison, plot_learning_curves
     from frontier_marl.training.validation import read_validation_log

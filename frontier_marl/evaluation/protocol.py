@@ -14,7 +14,7 @@ changes; on dynamic maps each seed also draws a fresh layout. Reported, as in SP
 * decision steps and cells travelled (the team's sum of ``travelled``) per episode;
 * cells travelled when coverage of the reachable free region (info ``coverage``) first reaches
   each level of ``coverage_levels`` (default 0.90 and 0.99), with how many episodes got there;
-* a coverage-versus-cells-travelled curve per episode (see :mod:`frontier_marl.metrics`).
+* a coverage-versus-cells-travelled curve per episode (see :mod:`frontier_marl.evaluation.metrics`).
 
 With a team (``n_agents > 1``) the result and its dict also hold the team metrics:
 
@@ -22,18 +22,18 @@ With a team (``n_agents > 1``) the result and its dict also hold the team metric
   the same time, so this is the time the team took, in cell moves;
 * ``makespan_to_coverage``: the longest single path when coverage first reaches each level
   (``cells_to_coverage`` stays the team's total cells travelled to that level);
-* ``overlap``: :func:`~frontier_marl.metrics.overlap_ratio` of the robots' ``seen`` masks at
-  the episode's end (sum of the areas each robot perceived / their union - 1; 0 for one
-  robot), when the env exposes its world;
+* ``overlap``: :func:`~frontier_marl.evaluation.metrics.overlap_ratio` of the robots'
+  ``seen`` masks at the episode's end (sum of the areas each robot perceived / their union
+  - 1; 0 for one robot), when the env exposes its world;
 * ``makespan_curve``: coverage versus the longest single path (coverage versus time), per
   episode; the row index of both curves is the decision step.
 
 The env may be a dict of keyword arguments for :func:`frontier_marl.parallel_env`, a
 zero-argument factory, or an env instance: a PettingZoo ``ParallelEnv`` or a single-robot
 Gymnasium env (possibly wrapped, e.g. for a learned model). The policy is anything with the
-:class:`~frontier_marl.policies.Policy` interface; wrap a plain ``obs -> action`` callable or an
-SB3 model with :class:`~frontier_marl.policies.CallablePolicy` /
-:class:`~frontier_marl.policies.ModelPolicy`.
+:class:`~frontier_marl.evaluation.Policy` interface; wrap a plain ``obs -> action`` callable or an
+SB3 model with :class:`~frontier_marl.evaluation.CallablePolicy` /
+:class:`~frontier_marl.evaluation.ModelPolicy`.
 """
 
 from __future__ import annotations
@@ -46,7 +46,8 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.metrics import (
+from frontier_marl.evaluation import Policy
+from frontier_marl.evaluation.metrics import (
     action_shares,
     cells_to_coverage,
     coverage_curve,
@@ -54,21 +55,8 @@ from frontier_marl.metrics import (
     mean_std,
     overlap_ratio,
 )
-from frontier_marl.policies import Policy
-
-#: The thesis's heuristic baselines (SPEC section 6): (preset, map mode, policy) -> (mean, std)
-#: of the total episode reward over 30 episodes, one robot.
-THESIS_FIGURES: dict[tuple[str, str, str], tuple[float, float]] = {
-    ("thesis-20x20", "static", "greedy-distance"): (16.48, 1.78),
-    ("thesis-20x20", "static", "greedy-gain"): (15.01, 1.12),
-}
 
 DEFAULT_LEVELS: tuple[float, ...] = (0.90, 0.99)
-
-
-def thesis_figure(preset: str, map_mode: str, policy: str) -> tuple[float, float] | None:
-    """The thesis's (mean, std) for this setting, or ``None`` where SPEC gives none."""
-    return THESIS_FIGURES.get((preset, map_mode, policy))
 
 
 def level_key(level: float) -> str:
@@ -410,7 +398,7 @@ def evaluate(
     Args:
         env: kwargs for :func:`frontier_marl.parallel_env` (e.g. ``{"preset": "thesis-20x20",
             "map_mode": "static"}``), a zero-argument env factory, or an env instance.
-        policy: a :class:`~frontier_marl.policies.Policy`; it is attached to the env once and
+        policy: a :class:`~frontier_marl.evaluation.Policy`; it is attached to the env once and
             reset with each episode's seed.
         episodes: number of episodes (>= 1).
         seed: episode ``i`` uses reset seed ``seed + i``.

@@ -1,30 +1,6 @@
-"""Frontier-selection policies behind one interface: heuristics, and adapters for learned models.
+"""Joint heuristics: one decision for the whole team from every robot's slot table.
 
-A :class:`Policy` picks one cluster slot per robot. It works with the single-robot Gymnasium
-env (:meth:`Policy.act`) and with every robot of the PettingZoo ParallelEnv
-(:meth:`Policy.act_team`)::
-
-    policy = make_policy("greedy-distance")
-    policy.reset(seed=0)
-    obs, infos = par_env.reset(seed=0)
-    actions = policy.act_team(obs, infos)          # {"robot_0": slot, ...}
-
-The heuristics read only a robot's step info: its typed slot table ``info["slots"]`` (cluster,
-target, Euclidean centroid ``distance``, known-free ``path_length``, size and ``gain`` per
-slot; see :class:`~frontier_marl.core.slots.SlotTable`) and ``action_mask``, never hidden env
-state:
-
-* ``greedy-distance``: the nearest cluster (smallest Euclidean centroid ``distance``; ties:
-  lowest slot).
-* ``greedy-gain``: the largest information ``gain`` (ties: nearest, then lowest slot).
-* ``cost-utility``: the largest ``gain / path length``, the path length being the 4-connected
-  shortest path (what A* returns) from the robot to the cluster's target over the known-free
-  cells of the belief (a length of 0 counts as 1). Ties: nearest, then lowest slot.
-* ``random``: uniform over the valid slots of ``action_mask``, from its own seeded generator.
-* ``first-slot``: always slot 0, the thesis's degenerate policy as a baseline (greedy distance
-  when slots are sorted; the top-most of the selected clusters when unsorted).
-
-Two *joint* heuristics decide for the whole team at once (:meth:`Policy.act_team`). They read
+The joint heuristics decide for the whole team at once (:meth:`Policy.act_team`). They read
 each robot's slot table. Clusters are matched across robots by their ``cluster`` index, which
 is the same for every robot because the belief is shared. Path costs are the slots' known-free
 path lengths.
@@ -48,158 +24,16 @@ path lengths.
   ``perception_range``, read by :meth:`Policy.attach`, or ``sensor_range=``). ``beta = 1``. A
   claimed target drops to utility 0 for the others, so duplicates are discouraged but not
   forbidden. With one robot: its nearest cluster by path length, as ``coordinated-assignment``.
-
-With no live cluster every heuristic returns slot 0 (the env's idle action).
-
-Learned models plug in through :class:`CallablePolicy` (any ``obs -> action`` callable) or
-:class:`ModelPolicy` (anything with SB3's ``predict(obs, deterministic=...)``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from frontier_marl.core.slots import SlotTable
-
-Info = Mapping[str, Any]
-
-
-class Policy:
-    """Base class: one decision per robot from its observation and step info.
-
-    Subclasses override :meth:`act` (one robot) or :meth:`act_team` (all robots at once, for
-    joint policies). ``deterministic`` tells evaluators whether two runs with the same seeds
-    give the same actions.
-    """
-
-    name: str = "policy"
-    deterministic: bool = True
-
-    def reset(self, seed: int | None = None) -> None:
-        """Start a new episode; ``seed`` reseeds any internal randomness."""
-
-    def attach(self, env: Any) -> None:
-        """Give the policy the env it is about to act in (default: ignored)."""
-
-    def act(self, obs: Any, info: Info) -> int:
-        """The slot chosen by one robot."""
-        raise NotImplementedError
-
-    def act_team(
-        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
-    ) -> dict[str, int]:
-        """One slot per robot (the keys of ``observations``), each robot deciding alone."""
-        return {agent: self.act(obs, infos[agent]) for agent, obs in observations.items()}
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(name={self.name!r})"
-
-
-class HeuristicPolicy(Policy):
-    """A policy that applies :meth:`choose` to each robot's info independently."""
-
-    def act(self, obs: Any, info: Info) -> int:
-        return int(self.choose(info))
-
-    def choose(self, info: Info) -> int:
-        raise NotImplementedError
-
-
-def _slots(info: Info) -> SlotTable:
-    try:
-        return info["slots"]
-    except (KeyError, TypeError) as exc:
-        raise ValueError(
-            "info must hold the robot's 'slots' table (the env's step info with info='full')"
-        ) from exc
-
-
-def _first(*keys: np.ndarray) -> int:
-    """The index that sorts first by ``keys`` (the first key most significant; ties: lowest)."""
-    return int(np.lexsort((np.arange(len(keys[0])), *reversed(keys)))[0])
-
-
-class GreedyDistance(HeuristicPolicy):
-    """Nearest cluster: smallest centroid distance; ties go to the lowest slot."""
-
-    name = "greedy-distance"
-
-    def choose(self, info: Info) -> int:
-        table = _slots(info)
-        if not table.live:
-            return 0
-        return int(np.argmin(table.distance[: table.live]))
-
-
-class GreedyGain(HeuristicPolicy):
-    """Largest information gain; ties go to the nearest, then the lowest slot."""
-
-    name = "greedy-gain"
-
-    def choose(self, info: Info) -> int:
-        table = _slots(info)
-        if not table.live:
-            return 0
-        live = table.live
-        return _first(-table.gain[:live], table.distance[:live])
-
-
-class FirstSlot(HeuristicPolicy):
-    """Always slot 0, the thesis's degenerate "reward hacking" policy as a baseline.
-
-    With distance-sorted slots this is greedy distance; unsorted (the default), slot 0 is the
-    first of the selected clusters in raster order, i.e. the top-most of the nearest ones.
-    """
-
-    name = "first-slot"
-
-    def choose(self, info: Info) -> int:
-        return 0
-
-
-class CostUtility(HeuristicPolicy):
-    """Largest ``gain / path length`` (known-free path; a length of 0 counts as 1); ties go to
-    the nearest, then the lowest slot."""
-
-    name = "cost-utility"
-
-    @staticmethod
-    def utilities(table: SlotTable) -> np.ndarray:
-        """``gain / max(path length, 1)`` of each live slot."""
-        live = table.live
-        return table.gain[:live] / np.maximum(table.path_length[:live], 1)
-
-    def choose(self, info: Info) -> int:
-        table = _slots(info)
-        if not table.live:
-            return 0
-        return _first(-self.utilities(table), table.distance[: table.live])
-
-
-class RandomValid(HeuristicPolicy):
-    """Uniform over the valid slots of ``action_mask`` (slot 0 when none is valid).
-
-    One generator serves every robot (drawn in agent order); :meth:`reset` reseeds it.
-    """
-
-    name = "random"
-    deterministic = False
-
-    def __init__(self, seed: int | None = None) -> None:
-        self._rng = np.random.default_rng(seed)
-
-    def reset(self, seed: int | None = None) -> None:
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
-
-    def choose(self, info: Info) -> int:
-        valid = np.flatnonzero(np.asarray(info["action_mask"]))
-        if len(valid) == 0:
-            return 0
-        return int(valid[self._rng.integers(len(valid))])
+from frontier_marl.evaluation.policies import Info, Policy, slot_table
 
 
 class _Option:
@@ -231,7 +65,7 @@ class TeamHeuristic(Policy):
         """Per robot (in the given order), its live clusters with their path lengths."""
         out = []
         for agent, info in enumerate(infos):
-            table = _slots(info)
+            table = slot_table(info)
             live = table.live
             rows = zip(
                 table.cluster[:live].tolist(),
@@ -376,60 +210,3 @@ class UtilityDiscount(TeamHeuristic):
                 distance = float(np.hypot(*(np.asarray(target, dtype=float) - claimed)))
                 utility[cluster] -= float(self.visibility(distance, sensor_range))
         return chosen
-
-
-class CallablePolicy(Policy):
-    """Wraps any ``obs -> action`` callable (e.g. a trained network) as a :class:`Policy`."""
-
-    def __init__(self, fn: Callable[[Any], Any], name: str = "callable") -> None:
-        self.fn = fn
-        self.name = name
-
-    def act(self, obs: Any, info: Info) -> int:
-        return _as_slot(self.fn(obs))
-
-
-class ModelPolicy(Policy):
-    """Wraps a model with SB3's ``predict(obs, deterministic=...) -> (action, state)``."""
-
-    def __init__(self, model: Any, name: str = "model", deterministic: bool = True) -> None:
-        if not hasattr(model, "predict"):
-            raise ValueError(f"model must have a predict() method, got {type(model).__name__}")
-        self.model = model
-        self.name = name
-        self.deterministic = deterministic
-
-    def act(self, obs: Any, info: Info) -> int:
-        action, _ = self.model.predict(obs, deterministic=self.deterministic)
-        return _as_slot(action)
-
-
-def _as_slot(action: Any) -> int:
-    value = np.asarray(action)
-    if value.size != 1:
-        raise ValueError(f"a policy must return one slot index, got shape {value.shape}")
-    return int(value.reshape(()).item())
-
-
-#: Heuristic name (as used on the command line) -> class.
-POLICIES: dict[str, type[Policy]] = {
-    "greedy-distance": GreedyDistance,
-    "greedy-gain": GreedyGain,
-    "cost-utility": CostUtility,
-    "random": RandomValid,
-    "first-slot": FirstSlot,
-    "coordinated-assignment": CoordinatedAssignment,
-    "utility-discount": UtilityDiscount,
-}
-
-#: The heuristics that decide for the whole team jointly.
-TEAM_POLICIES: tuple[str, ...] = ("coordinated-assignment", "utility-discount")
-
-
-def make_policy(name: str, seed: int | None = None) -> Policy:
-    """A fresh heuristic by name; ``seed`` seeds the random policy (ignored by the others)."""
-    if name not in POLICIES:
-        raise ValueError(f"policy must be one of {list(POLICIES)}, got {name!r}")
-    policy = POLICIES[name]()
-    policy.reset(seed)
-    return policy

@@ -7,8 +7,8 @@ from an evaluation dict in memory (:func:`summary_row`, what a Ray trial reports
 folder on disk (:func:`run_summary`, :func:`collect_runs`), and are written as Markdown, CSV
 and JSON (:func:`write_table`).
 
-The thesis's DQN figures (SPEC section 6) are kept in :data:`THESIS_DQN_RESULTS`; a row of a
-configuration the thesis reports gets them beside ours (``thesis`` column).
+A row of a configuration the thesis reports gets its figure (:data:`frontier_marl.thesis.
+DQN_RESULTS`) beside ours (``thesis`` column).
 """
 
 from __future__ import annotations
@@ -20,41 +20,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-#: The thesis's DQN results, 20 x 20, static map, 30 deterministic evaluation episodes
-#: (SPEC section 6), by experiment name. ``mean``/``std``/``terminations`` are ``None`` where
-#: the thesis gives no number.
-THESIS_DQN_RESULTS: dict[str, dict[str, Any]] = {
-    "config01": {
-        "mean": 15.55,
-        "std": 2.45,
-        "terminations": 25,
-        "episodes": 30,
-        "action_shares": [0.506, 0.254, 0.212, 0.028],
-        "steps": 1_000_000,
-        "note": "genuine policy; TD loss bounded ~0.01-0.2",
-    },
-    "config04": {
-        "mean": 16.91,
-        "std": 0.57,
-        "terminations": None,
-        "episodes": 30,
-        "note": "degenerate: almost always action 0; TD loss diverged to ~1e6",
-    },
-    "config05": {
-        "mean": None,
-        "std": None,
-        "terminations": None,
-        "episodes": 30,
-        "note": "collapse to near-zero reward",
-    },
-    "config10": {
-        "mean": 16.66,
-        "std": 0.75,
-        "terminations": 28,
-        "episodes": 30,
-        "note": "degenerate: 95.1 % action 0",
-    },
-}
+from frontier_marl.thesis import dqn_result_text
 
 #: Columns of a summary table, in order.
 SUMMARY_COLUMNS: tuple[str, ...] = (
@@ -74,19 +40,6 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "wall_time_s",
     "run_dir",
 )
-
-
-def thesis_text(config: str) -> str:
-    """The thesis's result for ``config`` as one short cell (``""`` where it has none)."""
-    figure = THESIS_DQN_RESULTS.get(config)
-    if figure is None:
-        return ""
-    if figure["mean"] is None:
-        return f"({figure['note']})"
-    text = f"{figure['mean']:.2f} ± {figure['std']:.2f}"
-    if figure.get("terminations") is not None:
-        text += f", {figure['terminations']}/{figure['episodes']}"
-    return text
 
 
 def summary_row(
@@ -120,7 +73,7 @@ def summary_row(
         "dominant_action": deg.get("dominant_action"),
         "dominant_share": deg.get("dominant_share"),
         "greedy_distance_mean": None if greedy is None else float(greedy["mean_reward"]),
-        "thesis": thesis_text(config),
+        "thesis": dqn_result_text(config),
         "wall_time_s": None if wall_time_s is None else round(float(wall_time_s), 2),
         "run_dir": None if run_dir is None else str(run_dir),
     }

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.metrics import mean_curve
+from frontier_marl.evaluation.metrics import mean_curve
 
 
 def _pyplot() -> Any:

@@ -1,0 +1,120 @@
+"""Frontier-selection policies behind one interface, and the registry of heuristics by name.
+
+A :class:`Policy` picks one cluster slot per robot. It works with the single-robot Gymnasium
+env (:meth:`Policy.act`) and with every robot of the PettingZoo ParallelEnv
+(:meth:`Policy.act_team`)::
+
+    policy = make_policy("greedy-distance")
+    policy.reset(seed=0)
+    obs, infos = par_env.reset(seed=0)
+    actions = policy.act_team(obs, infos)          # {"robot_0": slot, ...}
+
+The heuristics are in :mod:`frontier_marl.evaluation.heuristics` (one robot at a time) and
+:mod:`frontier_marl.evaluation.team` (the whole team jointly). With no live cluster every
+heuristic returns slot 0 (the env's idle action).
+
+Learned models plug in through :class:`CallablePolicy` (any ``obs -> action`` callable) or
+:class:`ModelPolicy` (anything with SB3's ``predict(obs, deterministic=...)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.core.slots import SlotTable
+
+Info = Mapping[str, Any]
+
+
+class Policy:
+    """Base class: one decision per robot from its observation and step info.
+
+    Subclasses override :meth:`act` (one robot) or :meth:`act_team` (all robots at once, for
+    joint policies). ``deterministic`` tells evaluators whether two runs with the same seeds
+    give the same actions.
+    """
+
+    name: str = "policy"
+    deterministic: bool = True
+
+    def reset(self, seed: int | None = None) -> None:
+        """Start a new episode; ``seed`` reseeds any internal randomness."""
+
+    def attach(self, env: Any) -> None:
+        """Give the policy the env it is about to act in (default: ignored)."""
+
+    def act(self, obs: Any, info: Info) -> int:
+        """The slot chosen by one robot."""
+        raise NotImplementedError
+
+    def act_team(
+        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
+    ) -> dict[str, int]:
+        """One slot per robot (the keys of ``observations``), each robot deciding alone."""
+        return {agent: self.act(obs, infos[agent]) for agent, obs in observations.items()}
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(name={self.name!r})"
+
+
+class HeuristicPolicy(Policy):
+    """A policy that applies :meth:`choose` to each robot's info independently."""
+
+    def act(self, obs: Any, info: Info) -> int:
+        return int(self.choose(info))
+
+    def choose(self, info: Info) -> int:
+        raise NotImplementedError
+
+
+def slot_table(info: Info) -> SlotTable:
+    try:
+        return info["slots"]
+    except (KeyError, TypeError) as exc:
+        raise ValueError(
+            "info must hold the robot's 'slots' table (the env's step info with info='full')"
+        ) from exc
+
+
+def first_by(*keys: np.ndarray) -> int:
+    """The index that sorts first by ``keys`` (the first key most significant; ties: lowest)."""
+    return int(np.lexsort((np.arange(len(keys[0])), *reversed(keys)))[0])
+
+
+class CallablePolicy(Policy):
+    """Wraps any ``obs -> action`` callable (e.g. a trained network) as a :class:`Policy`."""
+
+    def __init__(self, fn: Callable[[Any], Any], name: str = "callable") -> None:
+        self.fn = fn
+        self.name = name
+
+    def act(self, obs: Any, info: Info) -> int:
+        return _as_slot(self.fn(obs))
+
+
+class ModelPolicy(Policy):
+    """Wraps a model with SB3's ``predict(obs, deterministic=...) -> (action, state)``."""
+
+    def __init__(self, model: Any, name: str = "model", deterministic: bool = True) -> None:
+        if not hasattr(model, "predict"):
+            raise ValueError(f"model must have a predict() method, got {type(model).__name__}")
+        self.model = model
+        self.name = name
+        self.deterministic = deterministic
+
+    def act(self, obs: Any, info: Info) -> int:
+        action, _ = self.model.predict(obs, deterministic=self.deterministic)
+        return _as_slot(action)
+
+
+def _as_slot(action: Any) -> int:
+    value = np.asarray(action)
+    if value.size != 1:
+        raise ValueError(f"a policy must return one slot index, got shape {value.shape}")
+    return int(value.reshape(()).item())
+
+
+#: Heuristic name (as used on the command line) -> class.

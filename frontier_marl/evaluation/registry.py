@@ -1,0 +1,36 @@
+"""Every heuristic by its command-line name, and :func:`make_policy`."""
+
+from __future__ import annotations
+
+from frontier_marl.evaluation.heuristics import (
+    CostUtility,
+    FirstSlot,
+    GreedyDistance,
+    GreedyGain,
+    RandomValid,
+)
+from frontier_marl.evaluation.policies import Policy
+from frontier_marl.evaluation.team import CoordinatedAssignment, UtilityDiscount
+
+#: Heuristic name (as used on the command line) -> class.
+POLICIES: dict[str, type[Policy]] = {
+    "greedy-distance": GreedyDistance,
+    "greedy-gain": GreedyGain,
+    "cost-utility": CostUtility,
+    "random": RandomValid,
+    "first-slot": FirstSlot,
+    "coordinated-assignment": CoordinatedAssignment,
+    "utility-discount": UtilityDiscount,
+}
+
+#: The heuristics that decide for the whole team jointly.
+TEAM_POLICIES: tuple[str, ...] = ("coordinated-assignment", "utility-discount")
+
+
+def make_policy(name: str, seed: int | None = None) -> Policy:
+    """A fresh heuristic by name; ``seed`` seeds the random policy (ignored by the others)."""
+    if name not in POLICIES:
+        raise ValueError(f"policy must be one of {list(POLICIES)}, got {name!r}")
+    policy = POLICIES[name]()
+    policy.reset(seed)
+    return policy
