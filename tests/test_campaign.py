@@ -45,7 +45,7 @@ def test_missing_ray_exits_2_with_install_hint(
 
 
 def test_require_ray_raises_an_import_error(monkeypatch: pytest.MonkeyPatch) -> None:
-    from frontier_marl.workflows.campaign import RayNotInstalledError, require_ray
+    from frontier_marl.workflows.ray_tune import RayNotInstalledError, require_ray
 
     monkeypatch.setitem(sys.modules, "ray", None)
     with pytest.raises(RayNotInstalledError, match=r"frontier-marl\[ray\]"):

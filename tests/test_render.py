@@ -16,12 +16,11 @@ from frontier_marl.render import (
     COLOR_OCCUPIED,
     COLOR_UNKNOWN,
     ROBOT_PALETTE,
-    HumanViewer,
     frame_shape,
     render_ansi,
     render_rgb,
-    write_gif,
 )
+from frontier_marl.viewer import HumanViewer, write_gif
 
 PX = 12
 H, W = 3, 5

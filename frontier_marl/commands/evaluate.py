@@ -159,7 +159,7 @@ def run(args: argparse.Namespace) -> int:
     )
     print(format_comparison(result))
     if args.json is not None:
-        from frontier_marl.training.train import write_json
+        from frontier_marl.json_files import write_json
 
         write_json(result, args.json)
         print(f"wrote {args.json}")

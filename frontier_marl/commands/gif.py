@@ -107,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--fps must be > 0, got {args.fps}")
     except ValueError as exc:
         return fail("gif", str(exc))
-    from frontier_marl.render import write_gif
+    from frontier_marl.viewer import write_gif
 
     frames, reward, steps, reason = record_episode(
         env_kwargs, args.policy, args.seed, args.cell_px, args.max_steps

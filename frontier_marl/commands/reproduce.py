@@ -131,7 +131,8 @@ def _print_summary(result: object) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from frontier_marl.commands.arguments import fail
-    from frontier_marl.workflows.reproduce import format_comparison_markdown, reproduce
+    from frontier_marl.workflows.comparison import format_comparison_markdown
+    from frontier_marl.workflows.reproduce import reproduce
 
     try:
         result = reproduce(

@@ -61,7 +61,7 @@ class Renderer:
         if self.mode != "human":
             return image
         if self._viewer is None:
-            from frontier_marl.render import HumanViewer
+            from frontier_marl.viewer import HumanViewer
 
             self._viewer = HumanViewer(fps=self.fps)
         self._viewer.show(image)

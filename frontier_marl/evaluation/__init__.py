@@ -1,6 +1,7 @@
 """The evaluation layer: the thesis's protocol, exploration metrics, the heuristics, plots.
 
-* :mod:`~frontier_marl.evaluation.protocol`: :func:`evaluate` and its records;
+* :mod:`~frontier_marl.evaluation.protocol`: :func:`evaluate`; its records in
+  :mod:`~frontier_marl.evaluation.records`;
 * :mod:`~frontier_marl.evaluation.metrics`: coverage curves, cells to a coverage level, overlap;
 * :mod:`~frontier_marl.evaluation.policies`: the :class:`Policy` interface and model adapters;
   :mod:`~frontier_marl.evaluation.heuristics` and :mod:`~frontier_marl.evaluation.team`: the
@@ -16,13 +17,12 @@ from frontier_marl.evaluation.heuristics import (
     RandomValid,
 )
 from frontier_marl.evaluation.policies import CallablePolicy, HeuristicPolicy, ModelPolicy, Policy
-from frontier_marl.evaluation.protocol import (
+from frontier_marl.evaluation.protocol import evaluate, run_episode
+from frontier_marl.evaluation.records import (
     DEFAULT_LEVELS,
     EpisodeRecord,
     EvaluationResult,
-    evaluate,
     level_key,
-    run_episode,
 )
 from frontier_marl.evaluation.registry import POLICIES, TEAM_POLICIES, make_policy
 from frontier_marl.evaluation.team import CoordinatedAssignment, TeamHeuristic, UtilityDiscount

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import make_config
+from frontier_marl.json_files import write_json
 from frontier_marl.training.checkpoints import (
     MODEL_FILE,
     Checkpoint,
@@ -41,6 +42,7 @@ from frontier_marl.training.checkpoints import (
 )
 from frontier_marl.training.experiment import Experiment, TrainSettings, experiment_from_dict
 from frontier_marl.training.metadata import build_metadata, save_metadata
+from frontier_marl.training.run_files import plot_learning_curve, record_session, set_logger
 from frontier_marl.training.validation import BEST_DIR
 
 #: Train settings a resumed run may change; everything else must match the checkpoint.
@@ -179,7 +181,7 @@ def train(
     model.action_space.seed(seed)
     skip_repeated_mode_switches(model.policy)
     policy = policy_name(model.observation_space)
-    _set_logger(model, run_dir, start_step, checkpoint is not None, verbose)
+    set_logger(model, run_dir, start_step, checkpoint is not None, verbose)
 
     def metadata() -> dict[str, Any]:
         return build_metadata(
@@ -243,7 +245,7 @@ def train(
     save_metadata(meta, run_dir / "model.json")
     files["model"] = model_path
     files["metadata"] = run_dir / "model.json"
-    _record_session(
+    record_session(
         run_dir,
         experiment,
         start_step,
@@ -266,7 +268,7 @@ def train(
         interrupted=interrupted,
         files=files,
     )
-    _plot_learning_curve(run_dir, experiment, result)
+    result.files["learning_curve"] = plot_learning_curve(run_dir, experiment, result.num_timesteps)
     if not interrupted and settings.eval_episodes > 0:
         eval_cfg = cfg
         if settings.eval_map_mode != "as-trained":
@@ -313,70 +315,6 @@ def skip_repeated_mode_switches(policy: Any) -> None:
     policy.set_training_mode = set_training_mode
 
 
-def _set_logger(model: Any, run_dir: Path, start_step: int, resumed: bool, verbose: int) -> None:
-    from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
-
-    from frontier_marl.training.callbacks import JsonLinesWriter, truncate_metrics
-
-    metrics = run_dir / "metrics.jsonl"
-    if resumed:
-        truncate_metrics(metrics, start_step)
-    elif metrics.exists():
-        metrics.unlink()
-    outputs: list[Any] = [
-        TensorBoardOutputFormat(str(run_dir / "tb")),
-        JsonLinesWriter(metrics),
-    ]
-    if verbose:
-        import sys
-
-        outputs.append(HumanOutputFormat(sys.stdout))
-    model.set_logger(Logger(folder=str(run_dir), output_formats=outputs))
-
-
-def _record_session(
-    run_dir: Path,
-    experiment: Experiment,
-    start: int,
-    end: int,
-    wall: float,
-    cpu: float,
-    interrupted: bool,
-    resumed_from: Path | None,
-) -> None:
-    path = run_dir / "run.json"
-    record = json.loads(path.read_text()) if path.is_file() else {"sessions": []}
-    record["experiment"] = experiment.to_dict()
-    record["sessions"].append(
-        {
-            "start_step": start,
-            "end_step": end,
-            "wall_time_s": round(wall, 3),
-            "steps_per_second": round((end - start) / wall, 1) if wall > 0 else None,
-            "cpu_time_s": round(cpu, 3),
-            "interrupted": interrupted,
-            "resumed_from": None if resumed_from is None else str(resumed_from),
-            "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
-        }
-    )
-    path.write_text(json.dumps(record, indent=2) + "\n")
-
-
-def _plot_learning_curve(run_dir: Path, experiment: Experiment, result: TrainResult) -> None:
-    from frontier_marl.training.callbacks import read_metrics
-    from frontier_marl.training.plots import plot_learning_curve
-    from frontier_marl.training.validation import read_validation_log
-
-    path = run_dir / "learning_curve.png"
-    plot_learning_curve(
-        read_metrics(run_dir / "metrics.jsonl"),
-        path,
-        title=f"{experiment.name} (seed {experiment.train.seed}, {result.num_timesteps} steps)",
-        validation=read_validation_log(run_dir),
-    )
-    result.files["learning_curve"] = path
-
-
 def _final_evaluation(
     model: Any,
     model_path: Path,
@@ -415,29 +353,3 @@ def _final_evaluation(
     result.files[f"evaluation{suffix}"] = path
     result.files[f"actions{suffix}"] = run_dir / "actions.png"
     return evaluation
-
-
-def write_json(data: Any, path: str | Path) -> Path:
-    """JSON with non-finite floats as ``null`` and numpy values as Python ones."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_json_safe(data), indent=1) + "\n")
-    return path
-
-
-def _json_safe(value: Any) -> Any:
-    import math
-
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, np.ndarray):
-        return _json_safe(value.tolist())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, Path):
-        return str(value)
-    return value

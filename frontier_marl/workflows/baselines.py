@@ -9,11 +9,12 @@ where the thesis gives one for that setting); :func:`format_table` prints them a
 from __future__ import annotations
 
 import json
-import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+from frontier_marl.json_files import json_safe
 
 DEFAULT_POLICIES = "greedy-distance,greedy-gain,cost-utility,random"
 
@@ -146,20 +147,10 @@ def describe(env_kwargs: dict[str, Any], episodes: int, seed: int) -> str:
     )
 
 
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    return value
-
-
 def dumps_rows(rows: Sequence[dict[str, Any]]) -> str:
     """JSON text of the rows: summary fields indented, one compact line per episode."""
     parts = []
-    for row in _json_safe(list(rows)):
+    for row in json_safe(list(rows)):
         episodes = row.pop("per_episode", None)
         text = json.dumps(row, indent=1)
         if episodes is not None:

@@ -8,7 +8,7 @@ the rows into ``OUT/campaign.md``, ``campaign.csv`` and ``campaign.json``.
 
 The experiments are read and validated by the driver and sent to the trials as dicts, so the
 workers need the ``frontier_marl`` package but not the TOML files. Ray is an optional extra
-(``pip install "frontier-marl[ray]"``): Ray Tune only, no RLlib. By default a local Ray
+(:mod:`frontier_marl.workflows.ray_tune`). By default a local Ray
 instance is started (``ray.init()``, all cores); ``address`` connects to an existing cluster
 (``"auto"`` or ``"ray://host:10001"``); an already initialised Ray is used as it is. On a
 multi-node cluster ``out`` must be a folder every node can write (shared storage) for the run
@@ -23,39 +23,24 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import signal
-import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.workflows.ray_tune import (
+    RayNotInstalledError,
+    fit_trials,
+    flat_scalars,
+    require_ray,
+)
 from frontier_marl.workflows.results import SUMMARY_COLUMNS, sort_rows, summary_row, write_table
 
-RAY_HINT = 'Ray Tune is not installed: pip install "frontier-marl[ray]"'
+__all__ = ["CampaignResult", "RayNotInstalledError", "TrialSpec", "build_grid", "run_campaign"]
 
 #: Extra columns of a campaign row (after :data:`~frontier_marl.workflows.results.SUMMARY_COLUMNS`).
 TRIAL_COLUMNS: tuple[str, ...] = ("status", "reused", "trial_wall_time_s", "node", "error")
-
-
-class RayNotInstalledError(ImportError):
-    """``ray[tune]`` is missing."""
-
-
-def require_ray() -> Any:
-    """``ray.tune``, or :class:`RayNotInstalledError` with the install hint."""
-    try:
-        import ray
-        from ray import tune
-    except ImportError as exc:
-        raise RayNotInstalledError(RAY_HINT) from exc
-    if not (hasattr(tune, "report") and hasattr(tune, "RunConfig")):  # added in Ray 2.41
-        raise RayNotInstalledError(
-            f"Ray {getattr(ray, '__version__', '?')} is too old (ray.tune.report and "
-            'ray.tune.RunConfig need Ray >= 2.41): pip install -U "frontier-marl[ray]"'
-        )
-    return tune
 
 
 @dataclass(frozen=True)
@@ -216,20 +201,7 @@ def _ray_trainable(config: dict[str, Any], trials: Sequence[TrialSpec]) -> None:
     """The Ray Tune function trainable: one grid cell, one final report."""
     from ray import tune
 
-    tune.report(_ray_safe(run_trial(trials[config["trial"]])))
-
-
-def _ray_safe(row: dict[str, Any]) -> dict[str, Any]:
-    """Tune's loggers want flat scalars: lists become JSON text, ``None`` NaN."""
-    out: dict[str, Any] = {}
-    for key, value in row.items():
-        if isinstance(value, list | tuple):
-            out[key] = json.dumps(list(value))
-        elif value is None:
-            out[key] = float("nan")
-        else:
-            out[key] = value
-    return out
+    tune.report(flat_scalars(run_trial(trials[config["trial"]])))
 
 
 #: Keys of a trial's report kept in the table (Tune adds its own bookkeeping keys).
@@ -237,7 +209,8 @@ _ROW_KEYS = (*SUMMARY_COLUMNS, "reused", "status", "trial_wall_time_s")
 
 
 def _row_from_report(report: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
-    """The table row of a trial's last report (undoing :func:`_ray_safe`)."""
+    """The table row of a trial's last report (undoing :func:`~frontier_marl.workflows.
+    ray_tune.flat_scalars`)."""
     row: dict[str, Any] = {}
     for key in _ROW_KEYS:
         value = report.get(key)
@@ -321,7 +294,17 @@ def run_campaign(
 
     started = time.perf_counter()
     try:
-        grid = _fit(tune, trials, out, cpus_per_trial, max_concurrent, progress)
+        names = [spec.name for spec in trials]
+        grid = fit_trials(
+            tune,
+            _ray_trainable,
+            names,
+            out,
+            cpus_per_trial,
+            max_concurrent,
+            progress,
+            trials=list(trials),
+        )
     finally:
         if started_ray:
             ray.shutdown()
@@ -357,111 +340,3 @@ def run_campaign(
         },
     )
     return CampaignResult(rows=rows, files=files, wall_time_s=wall)
-
-
-def _fit(
-    tune: Any,
-    trials: Sequence[TrialSpec],
-    out: Path,
-    cpus_per_trial: float,
-    max_concurrent: int | None,
-    progress: bool,
-) -> Any:
-    trainable = tune.with_resources(
-        tune.with_parameters(_ray_trainable, trials=list(trials)), {"cpu": cpus_per_trial}
-    )
-    callbacks = [_progress_callback(tune, trials, progress)]
-    tuner = tune.Tuner(
-        trainable,
-        param_space={"trial": tune.grid_search(list(range(len(trials))))},
-        tune_config=tune.TuneConfig(
-            max_concurrent_trials=max_concurrent,
-            trial_name_creator=lambda t: trials[t.config["trial"]].name,
-            trial_dirname_creator=lambda t: trials[t.config["trial"]].name,
-        ),
-        run_config=tune.RunConfig(
-            name=f"campaign_{time.strftime('%Y%m%d-%H%M%S')}",
-            storage_path=str(out / "ray_results"),
-            verbose=0,
-            callbacks=callbacks,
-        ),
-    )
-    return _restoring_signal_handlers(tuner.fit)
-
-
-def _restoring_signal_handlers(run: Any) -> Any:
-    """``run()``, then the SIGINT/SIGUSR1 handlers it found: Ray Tune's ``fit`` installs its
-    own and leaves them in place when the run ends normally, after which Ctrl-C no longer
-    raises ``KeyboardInterrupt`` anywhere in this process."""
-    names = [n for n in ("SIGINT", "SIGUSR1") if hasattr(signal, n)]
-    saved = {n: signal.getsignal(getattr(signal, n)) for n in names}
-    try:
-        return run()
-    finally:
-        if threading.current_thread() is threading.main_thread():
-            for name, handler in saved.items():
-                if handler is not None:
-                    signal.signal(getattr(signal, name), handler)
-
-
-def _progress_callback(tune: Any, trials: Sequence[TrialSpec], progress: bool) -> Any:
-    """A Tune callback (run in the driver): a tqdm bar over finished trials and one line per
-    finished trial. Tune pickles its callbacks, so the bar is made in ``setup``."""
-
-    class _Progress(tune.Callback):
-        def __init__(self) -> None:
-            self.names = [spec.name for spec in trials]
-            self.progress = progress
-            self.bar: Any = None
-
-        def __getstate__(self) -> dict[str, Any]:
-            return {**self.__dict__, "bar": None}
-
-        def setup(self, **info: Any) -> None:
-            import sys
-
-            from tqdm import tqdm
-
-            self.bar = tqdm(
-                total=len(self.names),
-                unit="trial",
-                disable=not self.progress,
-                file=sys.stderr,
-                dynamic_ncols=True,
-                desc="campaign",
-            )
-
-        def _done(self, trial: Any, text: str) -> None:
-            import sys
-
-            if self.bar is None:
-                self.setup()
-            line = f"{self.names[trial.config['trial']]}: {text}"
-            if self.progress:
-                self.bar.write(line, file=sys.stderr)
-            else:
-                print(line, flush=True)
-            self.bar.update(1)
-
-        def on_trial_complete(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
-            r = trial.last_result or {}
-            if "mean_reward" in r:
-                flag = ", DEGENERATE" if r.get("degenerate") else ""
-                text = (
-                    f"{r['mean_reward']:.2f} ± {r['std_reward']:.2f}, "
-                    f"{int(r['terminations'])}/{int(r['episodes'])} terminations{flag} "
-                    f"({r.get('trial_wall_time_s', 0):.0f} s)"
-                )
-            else:
-                text = "finished without a result"
-            self._done(trial, text)
-
-        def on_trial_error(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
-            self._done(trial, "FAILED")
-
-        def on_experiment_end(self, trials: list, **info: Any) -> None:
-            if self.bar is not None:
-                self.bar.close()
-                self.bar = None
-
-    return _Progress()

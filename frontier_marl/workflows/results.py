@@ -183,7 +183,7 @@ def write_table(
     extra: Mapping[str, Any] | None = None,
 ) -> dict[str, Path]:
     """``STEM.md``, ``STEM.csv`` and ``STEM.json`` (``{"rows": [...], **extra}``)."""
-    from frontier_marl.training.train import write_json
+    from frontier_marl.json_files import write_json
 
     stem = Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)

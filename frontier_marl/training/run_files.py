@@ -1,0 +1,78 @@
+"""The files of a run folder that record how it was trained: the logger outputs (TensorBoard,
+``metrics.jsonl``, the console), one ``run.json`` entry per session, and the learning curve."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from frontier_marl.training.experiment import Experiment
+
+
+def set_logger(model: Any, run_dir: Path, start_step: int, resumed: bool, verbose: int) -> None:
+    """TensorBoard (``RUN/tb``), ``RUN/metrics.jsonl`` (cut back to ``start_step`` on resume)
+    and, with ``verbose``, the console."""
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
+
+    from frontier_marl.training.callbacks import JsonLinesWriter, truncate_metrics
+
+    metrics = run_dir / "metrics.jsonl"
+    if resumed:
+        truncate_metrics(metrics, start_step)
+    elif metrics.exists():
+        metrics.unlink()
+    outputs: list[Any] = [
+        TensorBoardOutputFormat(str(run_dir / "tb")),
+        JsonLinesWriter(metrics),
+    ]
+    if verbose:
+        outputs.append(HumanOutputFormat(sys.stdout))
+    model.set_logger(Logger(folder=str(run_dir), output_formats=outputs))
+
+
+def record_session(
+    run_dir: Path,
+    experiment: Experiment,
+    start: int,
+    end: int,
+    wall: float,
+    cpu: float,
+    interrupted: bool,
+    resumed_from: Path | None,
+) -> None:
+    """Append this session (steps, wall and CPU time, interruption) to ``RUN/run.json``."""
+    path = run_dir / "run.json"
+    record = json.loads(path.read_text()) if path.is_file() else {"sessions": []}
+    record["experiment"] = experiment.to_dict()
+    record["sessions"].append(
+        {
+            "start_step": start,
+            "end_step": end,
+            "wall_time_s": round(wall, 3),
+            "steps_per_second": round((end - start) / wall, 1) if wall > 0 else None,
+            "cpu_time_s": round(cpu, 3),
+            "interrupted": interrupted,
+            "resumed_from": None if resumed_from is None else str(resumed_from),
+            "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
+        }
+    )
+    path.write_text(json.dumps(record, indent=2) + "\n")
+
+
+def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: int) -> Path:
+    """``RUN/learning_curve.png`` from the run's metrics and validation logs."""
+    from frontier_marl.training.callbacks import read_metrics
+    from frontier_marl.training.plots import plot_learning_curve as plot
+    from frontier_marl.training.validation import read_validation_log
+
+    path = run_dir / "learning_curve.png"
+    plot(
+        read_metrics(run_dir / "metrics.jsonl"),
+        path,
+        title=f"{experiment.name} (seed {experiment.train.seed}, {num_timesteps} steps)",
+        validation=read_validation_log(run_dir),
+    )
+    return path
