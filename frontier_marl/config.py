@@ -17,6 +17,14 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from frontier_marl.checks import (
+    check_bool,
+    check_choice,
+    check_finite,
+    check_int,
+    check_range,
+)
+
 CentroidEncoding = Literal["absolute", "relative", "distance", "none"]
 MapMode = Literal["static", "dynamic"]
 MapGenerator = Literal["random", "rooms"]
@@ -64,10 +72,10 @@ class ObservationConfig:
     teammates: TeammateEncoding = "none"
 
     def validate(self) -> None:
-        _check_choice("centroid", self.centroid, _CENTROIDS)
-        _check_choice("teammates", self.teammates, _TEAMMATES)
+        check_choice("centroid", self.centroid, _CENTROIDS)
+        check_choice("teammates", self.teammates, _TEAMMATES)
         for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
-            _check_bool(name, getattr(self, name))
+            check_bool(name, getattr(self, name))
         if self.centroid == "none" and not self.info_gain:
             raise ValueError(
                 "observation is empty: centroid='none' needs info_gain=True "
@@ -122,13 +130,13 @@ class RewardConfig:
     oscillation_penalty: float = -0.05
 
     def validate(self) -> None:
-        _check_choice("reward", self.kind, _REWARDS)
-        _check_choice("threshold_basis", self.threshold_basis, _BASES)
-        _check_range("explore_threshold", self.explore_threshold, 0.0, 1.0, low_open=True)
-        _check_int("max_steps", self.max_steps, 1)
-        _check_int("no_progress_limit", self.no_progress_limit, 1)
-        _check_int("oscillation_window", self.oscillation_window, 1)
-        _check_range("team_weight", self.team_weight, 0.0, 1.0)
+        check_choice("reward", self.kind, _REWARDS)
+        check_choice("threshold_basis", self.threshold_basis, _BASES)
+        check_range("explore_threshold", self.explore_threshold, 0.0, 1.0, low_open=True)
+        check_int("max_steps", self.max_steps, 1)
+        check_int("no_progress_limit", self.no_progress_limit, 1)
+        check_int("oscillation_window", self.oscillation_window, 1)
+        check_range("team_weight", self.team_weight, 0.0, 1.0)
         for name in (
             "cell_reward",
             "no_new_cell_penalty",
@@ -137,9 +145,9 @@ class RewardConfig:
             "no_progress_penalty",
             "oscillation_penalty",
         ):
-            _check_finite(name, getattr(self, name))
+            check_finite(name, getattr(self, name))
         if self.padding_penalty is not None:
-            _check_finite("padding_penalty", self.padding_penalty)
+            check_finite("padding_penalty", self.padding_penalty)
 
     @property
     def padding(self) -> float:
@@ -207,17 +215,17 @@ class EnvConfig:
 
     def validate(self) -> None:
         """Raise ``ValueError`` naming the first parameter out of its allowed range."""
-        _check_int("height", self.height, 3, 4096)
-        _check_int("width", self.width, 3, 4096)
-        _check_int("n_agents", self.n_agents, 1, 64)
-        _check_choice("map_generator", self.map_generator, _GENERATORS)
-        _check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
+        check_int("height", self.height, 3, 4096)
+        check_int("width", self.width, 3, 4096)
+        check_int("n_agents", self.n_agents, 1, 64)
+        check_choice("map_generator", self.map_generator, _GENERATORS)
+        check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
         if self.map_generator == "rooms" and min(self.height, self.width) < 5:
             raise ValueError(
                 f"map_generator='rooms' needs height and width >= 5, got {self.height}x{self.width}"
             )
-        _check_choice("map_mode", self.map_mode, _MAP_MODES)
-        _check_int("map_seed", self.map_seed, 0)
+        check_choice("map_mode", self.map_mode, _MAP_MODES)
+        check_int("map_seed", self.map_seed, 0)
         if self.map_path is not None:
             if not isinstance(self.map_path, str):
                 raise ValueError(f"map_path must be a file path string, got {self.map_path!r}")
@@ -225,16 +233,16 @@ class EnvConfig:
                 raise ValueError(
                     "map_mode must be 'static' with map_path (a file holds one fixed layout)"
                 )
-        _check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
-        _check_choice("sensor", self.sensor, _SENSORS)
+        check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
+        check_choice("sensor", self.sensor, _SENSORS)
         if self.cells_per_step != FULL_PATH:
-            _check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
-        _check_int("connectivity", self.connectivity, 4, 8)
+            check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
+        check_int("connectivity", self.connectivity, 4, 8)
         if self.connectivity not in (4, 8):
             raise ValueError(f"connectivity must be 4 or 8, got {self.connectivity!r}")
-        _check_int("max_cluster_cells", self.max_cluster_cells, 1)
-        _check_int("n_slots", self.n_slots, 1, 256)
-        _check_choice("gain", self.gain, _GAINS)
+        check_int("max_cluster_cells", self.max_cluster_cells, 1)
+        check_int("n_slots", self.n_slots, 1, 256)
+        check_choice("gain", self.gain, _GAINS)
         if not isinstance(self.observation, ObservationConfig):
             raise ValueError("observation must be an ObservationConfig")
         if not isinstance(self.reward, RewardConfig):
@@ -327,7 +335,7 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
         if isinstance(value, RewardConfig):
             reward = value
         else:
-            _check_choice("reward", value, _REWARDS)
+            check_choice("reward", value, _REWARDS)
             rew_kw["kind"] = value
     if isinstance(observation, ObservationConfig) and obs_kw:
         observation = dataclasses.replace(observation, **obs_kw)
@@ -358,42 +366,3 @@ def config_to_dict(cfg: EnvConfig) -> dict[str, Any]:
     flat.update({k: getattr(cfg.reward, k) for k in sorted(_REWARD_KEYS)})
     flat["reward"] = cfg.reward.kind
     return flat
-
-
-def _check_choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
-    if value not in choices:
-        raise ValueError(f"{name} must be one of {list(choices)}, got {value!r}")
-
-
-def _check_bool(name: str, value: Any) -> None:
-    if not isinstance(value, bool):
-        raise ValueError(f"{name} must be True or False, got {value!r}")
-
-
-def _check_int(
-    name: str, value: Any, low: int, high: int | None = None, extra_allowed: str = ""
-) -> None:
-    import numbers
-
-    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool)
-    if ok and value >= low and (high is None or value <= high):
-        return
-    allowed = f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]"
-    if extra_allowed:
-        allowed += f" or {extra_allowed}"
-    raise ValueError(f"{name} must be {allowed}, got {value!r}")
-
-
-def _check_finite(name: str, value: Any) -> None:
-    import math
-    import numbers
-
-    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-
-
-def _check_range(name: str, value: Any, low: float, high: float, low_open: bool = False) -> None:
-    _check_finite(name, value)
-    if (value <= low if low_open else value < low) or value > high:
-        bracket = "(" if low_open else "["
-        raise ValueError(f"{name} must be in {bracket}{low}, {high}], got {value!r}")

@@ -27,12 +27,12 @@ checkpoints (or re-evaluates finished ones); a seed with nothing to continue sta
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.checks import check_int
 from frontier_marl.workflows.comparison import (
     comparison_table,
     format_comparison_markdown,
@@ -58,14 +58,8 @@ class ReproduceResult:
     trains: list[Any] = field(default_factory=list)
 
 
-def _check_int(name: str, value: Any, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    return int(value)
-
-
 def _check_seeds(seeds: Sequence[int]) -> list[int]:
-    checked = [_check_int("seeds", seed, 0) for seed in seeds]
+    checked = [check_int("seeds", seed, 0) for seed in seeds]
     if not checked:
         raise ValueError("seeds must name at least one seed")
     if len(set(checked)) != len(checked):
@@ -93,10 +87,10 @@ def reproduce(
     from frontier_marl.training.workers import train_runs
     from frontier_marl.workflows.baselines import dumps_rows, run_baselines
 
-    steps = _check_int("steps", steps, 1)
+    steps = check_int("steps", steps, 1)
     seeds = _check_seeds(seeds)
-    jobs = len(seeds) if jobs is None else _check_int("jobs", jobs, 1)
-    episodes = _check_int("episodes", episodes, 1)
+    jobs = len(seeds) if jobs is None else check_int("jobs", jobs, 1)
+    episodes = check_int("episodes", episodes, 1)
     out = Path(out)
     settings = {"total_timesteps": steps, "eval_episodes": episodes, "eval_seed": 0}
     train_jobs = [_train_job(config, seed, settings, out, resume, log) for seed in seeds]
