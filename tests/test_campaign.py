@@ -73,7 +73,7 @@ def test_build_grid_lists_configs_seeds_budgets(tmp_path: Path) -> None:
     assert (train["total_timesteps"], train["seed"], train["eval_episodes"]) == (1000, 0, 2)
     assert train["checkpoint_every"] == 0
     assert Path(first.run_dir) == tmp_path.resolve() / "runs" / "config01" / "seed0_steps1000"
-    with pytest.raises(ValueError, match="not found"):
+    with pytest.raises(ValueError, match="neither a file nor a shipped config"):
         build_grid(["no-such-config"], [0], [1000], tmp_path)
     with pytest.raises(ValueError, match="steps"):
         build_grid(CONFIGS, [0], [0], tmp_path)

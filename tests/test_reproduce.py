@@ -1,8 +1,8 @@
-"""``frontier-marl reproduce`` end to end with a tiny budget (issue 4, items 5 and 10).
+"""``frontier-marl reproduce`` end to end with a tiny budget.
 
 The run starts from a working directory outside the repository, so the config lookup
-(``config01`` -> the repository's ``training/config01.toml``) is exercised as after an editable
-install. Nothing here checks learning quality.
+(``config01`` -> the config shipped in the package) is exercised as after an install. Nothing
+here checks learning quality.
 """
 
 from __future__ import annotations
@@ -190,13 +190,17 @@ def test_reproduce_rejects_bad_input(kwargs: dict, name: str, tmp_path: Path) ->
 def test_config_names_resolve_from_any_directory(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from frontier_marl.training.experiment import config_folders, resolve_config_path
+    from frontier_marl.training.experiment import load_experiment, shipped_configs
 
     monkeypatch.chdir(tmp_path)
-    assert resolve_config_path("config01") == REPO / "training" / "config01.toml"
-    assert REPO / "training" in config_folders()
-    with pytest.raises(ValueError, match="pip install -e"):
-        resolve_config_path("no-such-config")
+    assert {"config01", "config12", "team_30x30"} <= set(shipped_configs())
+    experiment = load_experiment("config01")
+    assert experiment.name == "config01" and experiment.source == "config01 (shipped)"
+    assert load_experiment("config01.toml").to_dict() == experiment.to_dict()
+    with pytest.raises(ValueError, match="neither a file nor a shipped config"):
+        load_experiment("no-such-config")
+    (tmp_path / "mine.toml").write_text('name = "mine"\n')  # a file path wins over names
+    assert load_experiment(tmp_path / "mine.toml").name == "mine"
 
 
 def test_reproduce_reports_the_best_validated_policy_beside_the_final_model(

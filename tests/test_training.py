@@ -186,7 +186,7 @@ THESIS_GRID = {
 
 @pytest.mark.parametrize("number", sorted(THESIS_GRID))
 def test_thesis_config_files(number: int) -> None:
-    experiment = load_experiment(REPO / "training" / f"config{number:02d}.toml")
+    experiment = load_experiment(f"config{number:02d}")
     cfg = experiment.env_config()
     centroid, position, gain, sort, size = THESIS_GRID[number]
     obs = cfg.observation

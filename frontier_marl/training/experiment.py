@@ -29,6 +29,7 @@ import math
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -323,43 +324,36 @@ def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str]) -> dict[s
     return out
 
 
-def config_folders() -> list[Path]:
-    """Where config names are looked up: ``./training`` and the repository's ``training/``.
-
-    The repository's folder is found from this file (``<repo>/frontier_marl/training/``), so
-    with an editable install (``pip install -e .``) ``config01`` resolves from any working
-    directory. ``training/*.toml`` is the only copy of the configs; a non-editable install
-    does not ship them (pass a TOML path then).
-    """
-    folders = [Path.cwd() / "training", Path(__file__).resolve().parents[2] / "training"]
-    return list(dict.fromkeys(folders))
+def shipped_configs() -> list[str]:
+    """The names of the experiment configs shipped with the package (``config01`` ...)."""
+    folder = resources.files("frontier_marl").joinpath("assets", "configs")
+    return sorted(
+        entry.name[: -len(".toml")] for entry in folder.iterdir() if entry.name.endswith(".toml")
+    )
 
 
-def resolve_config_path(config: str | Path) -> Path:
-    """A config file path, or the name of a file in the repository's ``training/`` folder."""
+def _read_config(config: str | Path) -> tuple[str, str]:
+    """(TOML text, source) of a config file path, or of a shipped config by name."""
     path = Path(config)
     if path.is_file():
-        return path
-    candidates = [path.with_suffix(".toml")] if path.suffix != ".toml" else []
-    folders = config_folders()
-    for folder in folders:
-        candidates += [folder / path.name, folder / f"{path.name}.toml"]
-    for candidate in candidates:
-        if candidate.is_file():
-            return candidate
+        return path.read_text(encoding="utf-8"), str(path)
+    if path.parent != Path("."):
+        raise ValueError(f"config file {str(config)!r} not found")
+    name = path.name[: -len(".toml")] if path.name.endswith(".toml") else path.name
+    if name in shipped_configs():
+        resource = resources.files("frontier_marl").joinpath("assets", "configs", f"{name}.toml")
+        return resource.read_text(encoding="utf-8"), f"{name} (shipped)"
     raise ValueError(
-        f"config file {str(config)!r} not found (looked in ., "
-        f"{', '.join(str(f) for f in folders)}); the configs are the repository's "
-        "training/*.toml: pass a TOML path, or install the package editable from a checkout "
-        "(pip install -e .)"
+        f"config {str(config)!r} is neither a file nor a shipped config "
+        f"({', '.join(shipped_configs())})"
     )
 
 
 def load_experiment(config: str | Path, overrides: Iterable[str] = ()) -> Experiment:
-    """Read a TOML experiment file (path or name under ``training/``) and apply overrides."""
-    path = resolve_config_path(config)
+    """Read a TOML experiment (a file path, or a shipped config's name) and apply overrides."""
+    text, source = _read_config(config)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"cannot parse {path}: {exc}") from exc
-    return experiment_from_dict(apply_overrides(data, overrides), source=str(path))
+        raise ValueError(f"cannot parse {source}: {exc}") from exc
+    return experiment_from_dict(apply_overrides(data, overrides), source=source)
