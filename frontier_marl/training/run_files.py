@@ -56,6 +56,7 @@ def record_session(
             "cpu_time_s": round(cpu, 3),
             "interrupted": interrupted,
             "resumed_from": None if resumed_from is None else str(resumed_from),
+            "machine": machine_name(),
             "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
         }
     )
@@ -76,3 +77,19 @@ def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: in
         validation=read_validation_log(run_dir),
     )
     return path
+
+
+def machine_name() -> str:
+    """The CPU model (from ``/proc/cpuinfo`` where there is one) and the core count: training
+    results depend on the CPU (docs/results.md)."""
+    import os
+    import platform
+
+    model = platform.processor() or platform.machine()
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.is_file():
+        for line in cpuinfo.read_text(errors="replace").splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    return f"{model}, {os.cpu_count()} cores"
