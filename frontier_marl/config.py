@@ -268,11 +268,12 @@ class EnvConfig:
         return _apply_overrides(self, overrides)
 
 
-#: Presets. ``thesis-20x20`` is the calibrated default (docs/calibration.md). ``thesis-30x30``
-#: is derived from it by rule, not by fitting: size 30x30 and perception range 5 (the thesis's
-#: second geometry), ``max_steps`` proportional to the number of cells (400 * 900 / 400) and
-#: ``max_cluster_cells`` = 2r + 2 (the edge of a sensor window plus one, 8 at r = 3); every
-#: other parameter is unchanged.
+#: Presets. ``thesis-20x20`` is the calibrated default (docs/calibration.md). The others are
+#: derived from it by rule, not by fitting: ``thesis-30x30`` has size 30x30 and perception
+#: range 5 (the thesis's second geometry), ``max_steps`` proportional to the number of cells
+#: (400 * 900 / 400) and ``max_cluster_cells`` = 2r + 2 (the edge of a sensor window plus one,
+#: 8 at r = 3); ``rooms-32`` is a 32x32 rooms-and-corridors map at the thesis's range (r = 3,
+#: ``max_steps`` 400 * 1024 / 400). Every other parameter is unchanged.
 PRESETS: dict[str, dict[str, Any]] = {
     "thesis-20x20": {},
     "thesis-30x30": {
@@ -281,6 +282,12 @@ PRESETS: dict[str, dict[str, Any]] = {
         "perception_range": 5,
         "max_steps": 900,
         "max_cluster_cells": 12,
+    },
+    "rooms-32": {
+        "map_generator": "rooms",
+        "height": 32,
+        "width": 32,
+        "max_steps": 1024,
     },
 }
 

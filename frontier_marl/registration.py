@@ -1,23 +1,48 @@
-"""Namespaced, versioned ids for Gymnasium and PettingZoo. Bump the version on behaviour change."""
+"""Namespaced, versioned ids for Gymnasium and PettingZoo: one generic id (any preset through
+``preset=``) and one id per preset, as Minigrid registers its variants. Bump the version when
+behaviour changes.
+
+    gymnasium.make("frontier_marl/FrontierExplore-Thesis30x30-v0")
+    pettingzoo.make("parallel", "frontier_marl/FrontierExplore-Rooms32-v0", n_agents=4)
+"""
 
 from __future__ import annotations
+
+from frontier_marl.config import PRESETS
 
 GYM_ID = "frontier_marl/FrontierExplore-v0"
 PETTINGZOO_ID = "frontier_marl/FrontierExplore-v0"
 
 
+def variant_id(preset: str) -> str:
+    """The id of a preset's variant, e.g. ``thesis-30x30`` -> ``...-Thesis30x30-v0``."""
+    name = "".join(part.capitalize() for part in preset.split("-"))
+    return f"frontier_marl/FrontierExplore-{name}-v0"
+
+
+#: Every registered id -> the env kwargs it stands for (the generic id: the default preset).
+VARIANTS: dict[str, dict[str, str]] = {
+    GYM_ID: {},
+    **{variant_id(preset): {"preset": preset} for preset in PRESETS},
+}
+
+
 def register_envs() -> None:
-    """Register the Gymnasium and PettingZoo ids (idempotent)."""
+    """Register every id with Gymnasium and PettingZoo (Parallel and AEC); idempotent."""
     import gymnasium
     import pettingzoo
 
-    if GYM_ID not in gymnasium.registry:
-        gymnasium.register(
-            id=GYM_ID,
-            entry_point="frontier_marl.envs.gym_env:FrontierExploreEnv",
-            disable_env_checker=False,
-        )
-    if PETTINGZOO_ID not in pettingzoo.parallel_registry:
-        pettingzoo.register("parallel", PETTINGZOO_ID, entry_point="frontier_marl:parallel_env")
-    if PETTINGZOO_ID not in pettingzoo.aec_registry:
-        pettingzoo.register("aec", PETTINGZOO_ID, entry_point="frontier_marl:env")
+    for env_id, kwargs in VARIANTS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(
+                id=env_id,
+                entry_point="frontier_marl.envs.gym_env:FrontierExploreEnv",
+                kwargs=dict(kwargs),
+                disable_env_checker=False,
+            )
+        if env_id not in pettingzoo.parallel_registry:
+            pettingzoo.register(
+                "parallel", env_id, entry_point="frontier_marl:parallel_env", kwargs=dict(kwargs)
+            )
+        if env_id not in pettingzoo.aec_registry:
+            pettingzoo.register("aec", env_id, entry_point="frontier_marl:env", kwargs=dict(kwargs))

@@ -14,32 +14,36 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import frontier_marl
 from frontier_marl import FrontierExploreEnv
+from frontier_marl.config import PRESETS as PRESET_TABLE
+from frontier_marl.config import make_config
+from frontier_marl.registration import VARIANTS, variant_id
 
-PRESETS = ("thesis-20x20", "thesis-30x30")
+PRESETS = tuple(PRESET_TABLE)
 MAP_MODES = ("static", "dynamic")
 OBSERVATIONS = {
     "box": {"agent_position": False},
     "dict": {"agent_position": True, "action_mask": True},
     "dict-pos": {"agent_position": True},
 }
+#: Every registered id, in both map modes, with each observation layout.
 CASES = [
-    pytest.param({"preset": p, "map_mode": m, **OBSERVATIONS[o]}, id=f"{p}-{m}-{o}")
-    for p, m, o in itertools.product(PRESETS, MAP_MODES, OBSERVATIONS)
+    pytest.param(env_id, {"map_mode": m, **OBSERVATIONS[o]}, id=f"{env_id.split('/')[1]}-{m}-{o}")
+    for env_id, m, o in itertools.product(VARIANTS, MAP_MODES, OBSERVATIONS)
 ]
 
 
-@pytest.mark.parametrize("kwargs", CASES)
-def test_gymnasium_check_env(kwargs: dict[str, Any]) -> None:
-    env = gymnasium.make(frontier_marl.GYM_ID, **kwargs)
+@pytest.mark.parametrize("env_id,kwargs", CASES)
+def test_gymnasium_check_env(env_id: str, kwargs: dict[str, Any]) -> None:
+    env = gymnasium.make(env_id, **kwargs)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # any checker warning is a failure
         gym_check_env(env.unwrapped, skip_render_check=True)
     env.close()
 
 
-@pytest.mark.parametrize("kwargs", CASES)
-def test_sb3_check_env(kwargs: dict[str, Any]) -> None:
-    env = gymnasium.make(frontier_marl.GYM_ID, **kwargs)
+@pytest.mark.parametrize("env_id,kwargs", CASES)
+def test_sb3_check_env(env_id: str, kwargs: dict[str, Any]) -> None:
+    env = gymnasium.make(env_id, **kwargs)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         sb3_check_env(env, warn=True)
@@ -55,12 +59,16 @@ def test_gymnasium_render_check(render_mode: str) -> None:
 
 
 @pytest.mark.parametrize("preset", PRESETS)
-def test_make_by_id(preset: str) -> None:
-    env = gymnasium.make(frontier_marl.GYM_ID, preset=preset)
+@pytest.mark.parametrize("by_variant", [False, True])
+def test_make_by_id(preset: str, by_variant: bool) -> None:
+    if by_variant:
+        env = gymnasium.make(variant_id(preset))
+    else:
+        env = gymnasium.make(frontier_marl.GYM_ID, preset=preset)
     base = env.unwrapped
     assert isinstance(base, FrontierExploreEnv)
-    side = 20 if preset == "thesis-20x20" else 30
-    assert (base.config.height, base.config.width) == (side, side)
+    assert base.config == make_config(preset)
+    side = base.config.height
     assert env.action_space == gymnasium.spaces.Discrete(base.config.n_slots)
     obs, info = env.reset(seed=0)
     assert env.observation_space.contains(obs)

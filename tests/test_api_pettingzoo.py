@@ -11,11 +11,14 @@ import pytest
 from pettingzoo.test import api_test, parallel_api_test, parallel_seed_test, render_test
 
 import frontier_marl
+from frontier_marl.config import PRESETS as PRESET_TABLE
+from frontier_marl.config import make_config
 from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.registration import VARIANTS, variant_id
 
 matplotlib.use("Agg")
 
-PRESETS = ("thesis-20x20", "thesis-30x30")
+PRESETS = tuple(PRESET_TABLE)
 MAP_MODES = ("static", "dynamic")
 N_AGENTS = (1, 3)
 # Flat Box observation, and a Dict one with the agent position and the action mask.
@@ -24,12 +27,14 @@ OBSERVATIONS = {
     "dict": {"agent_position": True, "action_mask": True},
 }
 
+#: Every registered id (as its env kwargs), in both map modes, alone and as a team, with each
+#: observation layout.
 CASES = [
     pytest.param(
-        {"preset": preset, "map_mode": mode, "n_agents": n, **OBSERVATIONS[obs]},
-        id=f"{preset}-{mode}-n{n}-{obs}",
+        {**VARIANTS[env_id], "map_mode": mode, "n_agents": n, **OBSERVATIONS[obs]},
+        id=f"{env_id.split('/')[1]}-{mode}-n{n}-{obs}",
     )
-    for preset, mode, n, obs in itertools.product(PRESETS, MAP_MODES, N_AGENTS, OBSERVATIONS)
+    for env_id, mode, n, obs in itertools.product(VARIANTS, MAP_MODES, N_AGENTS, OBSERVATIONS)
 ]
 
 # PettingZoo's checkers warn about Dict observations by design; they are not failures here.
@@ -84,7 +89,9 @@ def test_make_parallel_and_aec_by_id(preset: str) -> None:
     par = pettingzoo.make("parallel", frontier_marl.PETTINGZOO_ID, preset=preset, n_agents=2)
     assert isinstance(par, FrontierParallelEnv)
     assert par.possible_agents == ["robot_0", "robot_1"]
-    assert par.config.height == (20 if preset == "thesis-20x20" else 30)
+    assert par.config == make_config(preset, n_agents=2)
+    variant = pettingzoo.make("parallel", variant_id(preset), n_agents=2)
+    assert variant.config == par.config
     aec = pettingzoo.make("aec", frontier_marl.PETTINGZOO_ID, preset=preset, n_agents=2)
     assert isinstance(aec.unwrapped, FrontierParallelEnv)
     aec.reset(seed=0)
