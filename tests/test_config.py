@@ -194,7 +194,7 @@ def test_map_path_round_trip(map_file):
 
 # ----------------------------------------------------------------------------- presets
 def test_presets():
-    assert set(PRESETS) == {"thesis-20x20", "thesis-30x30"}
+    assert set(PRESETS) == {"thesis-20x20", "thesis-30x30", "rooms-32"}
     small = make_config(preset="thesis-20x20")
     assert (small.height, small.width, small.perception_range) == (20, 20, 3)
     large = make_config(preset="thesis-30x30")
@@ -202,6 +202,9 @@ def test_presets():
     assert large.shape == (30, 30)
     assert make_config() == small
     assert make_config(preset=None) == small
+    rooms = make_config(preset="rooms-32")
+    assert (rooms.map_generator, rooms.height, rooms.perception_range) == ("rooms", 32, 3)
+    assert rooms.reward.max_steps == 400 * 32 * 32 // (20 * 20)
 
 
 def test_overrides_win_over_presets():

@@ -127,12 +127,10 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
 
-    from tqdm import tqdm
+    from frontier_marl.progress import progress_bar
 
     total = args.episodes * (1 + len(heuristics))
-    with tqdm(
-        total=total, disable=args.no_progress, unit="ep", file=sys.stderr, dynamic_ncols=True
-    ) as bar:
+    with progress_bar(total, disable=args.no_progress, unit="ep") as bar:
 
         def tick(label: str, _i: int) -> None:
             bar.set_description(label)

@@ -41,9 +41,10 @@ class Periodic(BaseCallback):
 
 
 class ProgressBar(BaseCallback):
-    """A tqdm progress bar over the session's steps, with the rolling episode reward and
-    epsilon. Unlike SB3's ``ProgressBarCallback`` (a rich bar redrawn from every step, which
-    cost about a quarter of the training time here) it touches the bar every ``every`` steps.
+    """A progress bar (:mod:`frontier_marl.progress`) over the session's steps, with the
+    rolling episode reward and epsilon. Unlike SB3's ``ProgressBarCallback`` (a rich bar
+    redrawn from every step, which cost about a quarter of the training time here) it touches
+    the bar every ``every`` steps.
     """
 
     def __init__(self, every: int = 500) -> None:
@@ -54,21 +55,12 @@ class ProgressBar(BaseCallback):
         self._next = 0
 
     def _on_training_start(self) -> None:
-        import sys
-
-        from tqdm import tqdm
+        from frontier_marl.progress import progress_bar
 
         total = int(self.locals["total_timesteps"])
         self._shown = self.model.num_timesteps
         self._next = self._shown + self.every
-        self.pbar = tqdm(
-            total=total,
-            initial=self._shown,
-            unit="step",
-            file=sys.stderr,
-            dynamic_ncols=True,
-            smoothing=0.05,
-        )
+        self.pbar = progress_bar(total, initial=self._shown, unit="step", smoothing=0.05)
 
     def _on_step(self) -> bool:
         if self.model.num_timesteps >= self._next:

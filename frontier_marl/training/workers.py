@@ -155,25 +155,23 @@ def _drain(reports: Any, bars: _Bars, timeout: float) -> None:
 
 
 class _Bars:
-    """One tqdm bar per job (nothing when progress is off)."""
+    """One progress bar per job (nothing when progress is off)."""
 
     def __init__(self, jobs: Sequence[TrainJob], progress: bool) -> None:
         self._bars: list[Any] = []
         if not progress:
             return
-        from tqdm import tqdm
+        from frontier_marl.progress import progress_bar
 
         for i, job in enumerate(jobs):
             start = 0 if job.checkpoint is None else job.checkpoint.step
             self._bars.append(
-                tqdm(
-                    total=job.experiment.train.total_timesteps,
+                progress_bar(
+                    job.experiment.train.total_timesteps,
                     initial=start,
                     desc=job.label or f"run {i}",
                     position=i,
                     unit="step",
-                    file=sys.stderr,
-                    dynamic_ncols=True,
                     smoothing=0.05,
                 )
             )

@@ -9,7 +9,6 @@ where the thesis gives one for that setting); :func:`format_table` prints them a
 from __future__ import annotations
 
 import json
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -27,10 +26,9 @@ def run_baselines(
     progress: bool = True,
 ) -> list[dict[str, Any]]:
     """Evaluate each heuristic; one JSON-able row per policy (see ``EvaluationResult``)."""
-    from tqdm import tqdm
-
     from frontier_marl.config import make_config
     from frontier_marl.evaluation import evaluate, make_policy
+    from frontier_marl.progress import progress_bar
     from frontier_marl.thesis import heuristic_baseline
 
     cfg = make_config(**env_kwargs)
@@ -45,13 +43,7 @@ def run_baselines(
         == (base.height, base.width, base.perception_range)
     )
     rows = []
-    with tqdm(
-        total=episodes * len(policies),
-        disable=not progress,
-        unit="ep",
-        file=sys.stderr,
-        dynamic_ncols=True,
-    ) as bar:
+    with progress_bar(episodes * len(policies), disable=not progress, unit="ep") as bar:
         for name in policies:
             bar.set_description(name)
             result = evaluate(

@@ -99,7 +99,7 @@ def restoring_signal_handlers(run: Any) -> Any:
 
 
 def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
-    """A Tune callback (run in the driver): a tqdm bar over finished trials and one line per
+    """A Tune callback (run in the driver): a progress bar over finished trials and one line per
     finished trial. Tune pickles its callbacks, so the bar is made in ``setup``."""
 
     class _Progress(tune.Callback):
@@ -112,15 +112,10 @@ def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
             return {**self.__dict__, "bar": None}
 
         def setup(self, **info: Any) -> None:
-            from tqdm import tqdm
+            from frontier_marl.progress import progress_bar
 
-            self.bar = tqdm(
-                total=len(self.names),
-                unit="trial",
-                disable=not self.progress,
-                file=sys.stderr,
-                dynamic_ncols=True,
-                desc="campaign",
+            self.bar = progress_bar(
+                len(self.names), unit="trial", disable=not self.progress, desc="campaign"
             )
 
         def _done(self, trial: Any, text: str) -> None:
