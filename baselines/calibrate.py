@@ -1,6 +1,6 @@
 """Calibrate the parameters the thesis left open against its two 20x20 static baselines.
 
-The thesis reports, over 30 episodes on a static 20x20 map with r = 3 (SPEC section 6):
+The thesis reports, over 30 episodes on a static 20x20 map with r = 3 (docs/calibration.md):
 greedy distance 16.48 +- 1.78 and greedy information gain 15.01 +- 1.12 (total episode reward).
 This script searches the open parameters of the ``thesis-20x20`` setting and scores each
 setting by how well the two heuristics reproduce those figures::

@@ -1,4 +1,4 @@
-"""The multi-robot experiment of docs/multi-robot.md (issue 5, item 7, heuristic part).
+"""The multi-robot experiment of docs/multi-robot.md (heuristic part).
 
 1, 2 and 4 robots on the ``thesis-30x30`` preset (its static random-obstacle map) and on the
 64x64 rooms example map (``rooms-64``, with the same preset's sensor range r = 5), each driven by

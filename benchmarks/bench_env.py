@@ -1,4 +1,4 @@
-"""Speed benchmark of the simulator (issue 2, item 10). Not a test: run it by hand.
+"""Speed benchmark of the simulator (docs/performance.md). Not a test: run it by hand.
 
     python benchmarks/bench_env.py                 # everything, ~3 minutes on 2 cores
     python benchmarks/bench_env.py --skip-dqn      # decisions per second only

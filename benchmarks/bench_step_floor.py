@@ -1,4 +1,4 @@
-"""How low can the env's share of DQN training go? A lower bound for issue 2's 15 % target.
+"""How low can the env's share of DQN training go? A lower bound (docs/performance.md).
 
     python benchmarks/bench_step_floor.py                 # ~3 minutes on 2 cores
     python benchmarks/bench_step_floor.py --steps 30000 --chunks 15 --json floor.json

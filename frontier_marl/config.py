@@ -90,7 +90,7 @@ class ObservationConfig:
 
 @dataclass(frozen=True)
 class RewardConfig:
-    """The thesis's two reward tables (SPEC section 4) and their open parameters.
+    """The thesis's two reward tables (docs/environment.md) and their open parameters.
 
     Attributes:
         kind: ``reward1`` (harsh, padding truncates) or ``reward2`` (soft, oscillation penalty).

@@ -1,4 +1,4 @@
-"""Reward 1 and Reward 2 of the thesis (SPEC section 4), and the oscillation test.
+"""Reward 1 and Reward 2 of the thesis (docs/environment.md), and the oscillation test.
 
 Per robot and step, the terms add up:
 

@@ -1,4 +1,4 @@
-"""``frontier-marl campaign`` on Ray Tune (issue 4, item 8), with tiny budgets.
+"""``frontier-marl campaign`` on Ray Tune with tiny budgets.
 
 The Ray tests start a local Ray instance (2 CPUs, no dashboard) and are skipped when
 ``ray[tune]`` is not installed; the missing-Ray error path is tested by hiding the module.

@@ -1,4 +1,4 @@
-"""Tests for frontier_marl.rewards: the SPEC section 4 reward tables and the oscillation test."""
+"""Tests for frontier_marl.rewards: the thesis's reward tables and the oscillation test."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The team training configs (issue 5, item 6) and example map names in [env] map_path."""
+"""The team training configs and example map names in [env] map_path."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The DQN training pipeline (issue 4): vector env, seeding, truncation, runs, resume, configs.
+"""The DQN training pipeline: vector env, seeding, truncation, runs, resume, configs.
 
 Budgets are tiny (a few thousand steps on a 10 x 10 map); nothing here checks learning quality.
 """
@@ -167,7 +167,7 @@ def test_terminated_transitions_are_not_bootstrapped() -> None:
 
 # --------------------------------------------------------------------------- experiment configs
 
-#: SPEC section 5's grid: config -> (centroid, agent position, info gain, sorted, preset)
+#: The thesis's experiment grid: config -> (centroid, agent position, info gain, sorted, preset)
 THESIS_GRID = {
     1: ("absolute", True, False, False, 20),
     2: ("absolute", True, True, True, 20),

@@ -5,7 +5,7 @@ unsorted, Reward 2, thesis-20x20, static map) with the thesis's DQN hyperparamet
 it with the thesis protocol (30 deterministic episodes), for three seeds trained side by side
 in worker processes; runs the heuristic baselines (greedy-distance, greedy-gain, cost-utility,
 random) on the same episodes; and prints and saves the comparison with the thesis's figures
-(SPEC section 6): the seeds' policies pooled, each seed, and the spread across seeds::
+(docs/results.md): the seeds' policies pooled, each seed, and the spread across seeds::
 
     frontier-marl reproduce                              # 3 seeds x 1e6 steps, ~26 min on 2 cores
     frontier-marl reproduce --seed 0                     # one seed, ~14 min

@@ -3,7 +3,8 @@
 :func:`evaluate` runs a policy for ``episodes`` episodes; episode ``i`` resets the env with seed
 ``seed + i`` (and the policy with the same seed). On a static map every episode shares the
 layout drawn from the config's ``map_seed`` (recorded in the result) and only the start cell
-changes; on dynamic maps each seed also draws a fresh layout. Reported, as in SPEC section 5:
+changes; on dynamic maps each seed also draws a fresh layout. Reported, as in the thesis
+(docs/thesis-mapping.md):
 
 * total episode reward: mean and *population* standard deviation (numpy's default, the same as
   SB3's ``evaluate_policy``). With a team, an episode's reward is the mean over robots of each

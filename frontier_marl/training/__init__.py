@@ -1,4 +1,4 @@
-"""DQN training through SuperSuit and Stable-Baselines3 (issue 4).
+"""DQN training through SuperSuit and Stable-Baselines3 (training/README.md).
 
 * :mod:`~frontier_marl.training.experiment`: TOML experiment configs (``training/*.toml``).
 * :mod:`~frontier_marl.training.vec_env`: ParallelEnv -> SuperSuit -> SB3 vector env.

@@ -40,7 +40,8 @@ from frontier_marl.thesis import DQN_HYPERPARAMETERS
 #: The thesis's final DQN hyperparameters; everything else is SB3's default.
 THESIS_DQN = DQN_HYPERPARAMETERS
 
-#: DQN arguments the pipeline sets itself (seeding goes through set_random_seed, see DESIGN).
+#: DQN arguments the pipeline sets itself (seeding goes through set_random_seed: SuperSuit's
+#: vector env cannot be seeded by SB3, see frontier_marl.training.vec_env).
 _RESERVED_DQN = {
     "policy",
     "env",

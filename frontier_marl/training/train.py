@@ -14,10 +14,11 @@ Run folder::
                                      best-validated policy with its own evaluation.json
     RUN/run.json                     the experiment and one entry per training session
 
-Seeding follows DESIGN's traps: ``DQN(seed=...)`` is never used (SuperSuit's ``ConcatVecEnv``
-has no ``seed``); ``set_random_seed`` seeds python/numpy/torch, the action space is seeded for
-the epsilon-random actions, and every vector copy is reset with its own seed. A resumed session
-derives its seeds from ``(seed, step)`` so it does not replay the first session's episodes.
+Seeding (see :mod:`frontier_marl.training.vec_env`): ``DQN(seed=...)`` is never used
+(SuperSuit's ``ConcatVecEnv`` has no ``seed``); ``set_random_seed`` seeds python/numpy/torch,
+the action space is seeded for the epsilon-random actions, and every vector copy is reset with
+its own seed. A resumed session derives its seeds from ``(seed, step)`` so it does not replay
+the first session's episodes.
 """
 
 from __future__ import annotations
@@ -84,7 +85,7 @@ def default_run_dir(experiment: Experiment, root: str | Path = "runs") -> Path:
 
 
 def policy_name(observation_space: Any) -> str:
-    """``MultiInputPolicy`` for Dict observations, ``MlpPolicy`` for flat ones (SPEC 5)."""
+    """``MultiInputPolicy`` for Dict observations, ``MlpPolicy`` for flat ones (as the thesis)."""
     from gymnasium import spaces
 
     return "MultiInputPolicy" if isinstance(observation_space, spaces.Dict) else "MlpPolicy"

@@ -1,6 +1,6 @@
 """The training env: ParallelEnv -> SuperSuit vector env -> SB3 ``VecMonitor``.
 
-Pipeline (SPEC section 5, DESIGN "Known traps")::
+Pipeline (docs/thesis-mapping.md; the traps it avoids are below)::
 
     FrontierParallelEnv
       -> TimeLimitInfo                 (marks truncations for SB3's replay buffer)

@@ -151,7 +151,7 @@ def format_comparison_markdown(table: Mapping[str, Any]) -> str:
             f"{len(seeds)} at or above {MIN_MEAN} on their own.",
         ]
     checks = table["checks"]
-    lines += ["", f"Checks of the DQN row (the issue's bar for {training['thesis_steps']} steps):"]
+    lines += ["", f"Checks of the DQN row (the bar for {training['thesis_steps']} steps):"]
     lines += [f"- {name}: {'pass' if ok else 'FAIL'}" for name, ok in checks.items()]
     if len(seeds) > 1:
         lines.append(

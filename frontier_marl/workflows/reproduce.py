@@ -9,7 +9,7 @@ best-validated policy (the one the table reports, the final model beside it); ru
 heuristic baselines on the same env and the same episodes with
 :func:`frontier_marl.workflows.baselines.run_baselines`; and writes, under ``out``::
 
-    OUT/comparison.md, comparison.json     ours beside the thesis's figures (SPEC section 6):
+    OUT/comparison.md, comparison.json     ours beside the thesis's figures (docs/results.md):
                                            the seeds' policies pooled, each seed, the final
                                            models, the heuristics; the spread across seeds
     OUT/comparison_rewards.png             mean ± std per policy, thesis bars beside;
@@ -40,7 +40,7 @@ from frontier_marl.workflows.comparison import (
 )
 
 DEFAULT_CONFIG = "config01"
-#: Seeds trained by default: the issue asks for at least three runs and their spread.
+#: Seeds trained by default: at least three runs, to report their spread (docs/results.md).
 DEFAULT_SEEDS: tuple[int, ...] = (0, 1, 2)
 HEURISTICS: tuple[str, ...] = ("greedy-distance", "greedy-gain", "cost-utility", "random")
 
