@@ -111,7 +111,7 @@ class MinimalStep(gym.Env):
             self.n_slots,
             False,
         )
-        self.live = int(np.count_nonzero(self.slots[1]))
+        self.live = int(self.slots[9])
 
     def step(self, action: Any) -> Any:
         slot = int(action)
@@ -164,7 +164,7 @@ class MinimalStep(gym.Env):
             if self.steps >= reward_cfg.max_steps:
                 reward += reward_cfg.step_limit_penalty
                 truncated = True
-        cluster, valid, centroid, target_cells, distance, size, gain, _ = self.slots
+        _, _, centroid, target_cells, _, _, _, _, mask, _ = self.slots
         live = self.live
         features = np.zeros((self.n_slots, 2))
         features[:live] = centroid[:live]
@@ -172,9 +172,6 @@ class MinimalStep(gym.Env):
             "clusters": (features / self.scale).astype(np.float32).ravel(),
             "agent_position": (world._positions[0] / self.scale).astype(np.float32),
         }
-        mask = valid.astype(np.int8)
-        if not live:
-            mask[0] = 1
         info = StepInfo(
             explored_fraction=fraction,
             new_cells=new,

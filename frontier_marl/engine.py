@@ -33,7 +33,7 @@ from frontier_marl.rewards import OscillationDetector, StepEvents, StepOutcome, 
 Observation = np.ndarray | dict[str, np.ndarray]
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class StepResult:
     """One decision step of every robot, as arrays indexed by robot (read-only by convention).
 
@@ -81,7 +81,6 @@ class ExplorationMDP:
         self.world: World | None = None
         self._slots: list[SlotTable] = []
         self._oscillation: list[OscillationDetector] = []
-        self._heading = np.full((cfg.n_agents, 2), -1, dtype=np.int64)  # -1: no target
         self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
         self.steps_without_progress = 0
@@ -126,9 +125,8 @@ class ExplorationMDP:
         self.steps_without_progress = 0
         self.done = False
         self.last = None
-        self._heading[:] = -1
         self._refresh_slots()
-        return self._observations()
+        return self._observations(None, None)
 
     def step(self, actions: list[Any]) -> StepResult:
         """One decision per robot: ``actions[i]`` is robot i's slot index."""
@@ -139,21 +137,20 @@ class ExplorationMDP:
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
         slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
-        targets = np.full((n, 2), -1, dtype=np.int64)
-        padding = np.zeros(n, dtype=bool)
-        oscillation = np.zeros(n, dtype=bool)
-        for agent, (slot, table) in enumerate(zip(slots, self._slots, strict=True)):
+        goals: list[tuple[int, int] | None] = []
+        padding: list[bool] = []
+        oscillation: list[bool] = []
+        for slot, table, detector in zip(slots, self._slots, self._oscillation, strict=True):
             if slot < table.live:  # live slots come first
-                targets[agent] = table.target[slot]
                 row, col = table.target[slot].tolist()
-                oscillation[agent] = self._oscillation[agent].update((row, col))
+                goals.append((row, col))
+                padding.append(False)
             else:
-                padding[agent] = table.live > 0
-                oscillation[agent] = self._oscillation[agent].update(None)
+                goals.append(None)
+                padding.append(table.live > 0)
+            oscillation.append(detector.update(goals[-1]))
         world = self.world
-        moved = world.move(targets)
-        self._heading[:] = targets
-        self._heading[moved.reached] = -1
+        moved = world.move(goals)
         self.steps += 1
         new_cells = moved.new_cells.tolist()
         self.steps_without_progress = 0 if any(new_cells) else self.steps_without_progress + 1
@@ -161,8 +158,8 @@ class ExplorationMDP:
         fraction = world.explored_fraction(cfg.reward.threshold_basis)
         events = StepEvents(
             new_cells=new_cells,
-            padding=padding.tolist(),
-            oscillation=oscillation.tolist(),
+            padding=padding,
+            oscillation=oscillation,
             threshold_reached=fraction >= cfg.reward.explore_threshold,
             no_frontier_left=not any(table.live for table in self._slots),
             steps_taken=self.steps,
@@ -170,7 +167,15 @@ class ExplorationMDP:
         )
         outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
-        self.last = StepResult(self._observations(), targets, padding, oscillation, moved, outcome)
+        targets = np.array([(-1, -1) if goal is None else goal for goal in goals], dtype=np.int64)
+        self.last = StepResult(
+            self._observations(targets, moved.reached),
+            targets,
+            np.array(padding),
+            np.array(oscillation),
+            moved,
+            outcome,
+        )
         return self.last
 
     # ------------------------------------------------------------------ helpers
@@ -212,10 +217,14 @@ class ExplorationMDP:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         return [table.mask for table in self._slots]
 
-    def _observations(self) -> list[Observation]:
+    def _observations(
+        self, targets: np.ndarray | None, reached: np.ndarray | None
+    ) -> list[Observation]:
+        """Every robot's observation; ``targets`` and ``reached`` of the step just taken (None
+        after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        mates = self._teammate_table(positions)
+        mates = self._teammate_table(positions, targets, reached)
         return [
             self.encoder.encode(
                 table,
@@ -225,13 +234,18 @@ class ExplorationMDP:
             for agent, table in enumerate(self._slots)
         ]
 
-    def _teammate_table(self, positions: np.ndarray) -> np.ndarray | None:
+    def _teammate_table(
+        self, positions: np.ndarray, targets: np.ndarray | None, reached: np.ndarray | None
+    ) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (zeros where a robot has
-        none); None if not observed."""
+        none: before its first decision, idle, or on its target); None if not observed."""
         layout = self.cfg.observation.teammates
         if layout == "none":
             return None
         if layout == "positions":
             return positions.astype(np.float64)
-        targets = np.where(self._heading < 0, 0, self._heading).astype(np.float64)
-        return np.concatenate([positions, targets], axis=1)
+        heading = np.zeros((len(positions), 2))
+        if targets is not None:
+            going = (targets[:, 0] >= 0) & ~reached
+            heading[going] = targets[going]
+        return np.concatenate([positions, heading], axis=1)

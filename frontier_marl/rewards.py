@@ -55,7 +55,7 @@ class OscillationDetector:
         return oscillates
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class StepEvents:
     """What happened in one decision step, per robot (sequences of length N) and for the team."""
 
@@ -68,7 +68,7 @@ class StepEvents:
     steps_without_progress: int  # consecutive, this one included
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class StepOutcome:
     rewards: np.ndarray  # float (N,)
     terminated: bool

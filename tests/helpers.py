@@ -43,7 +43,7 @@ def slot_table(live: Sequence[dict[str, Any]], n_slots: int = 4) -> SlotTable:
         return np.array([row[key] for row in live] + [pad] * (n_slots - n), dtype=dtype)
 
     gain = column("gain", float, 0.0)
-    return SlotTable(
+    return SlotTable.from_arrays(
         cluster=cluster,
         valid=np.arange(n_slots) < n,
         centroid=centroid,
@@ -52,7 +52,6 @@ def slot_table(live: Sequence[dict[str, Any]], n_slots: int = 4) -> SlotTable:
         size=gain.astype(np.int64),
         gain=gain,
         path_length=column("path_length", np.int64, -1),
-        live=n,
     )
 
 

@@ -25,7 +25,7 @@ _STRUCTURES = {
 _EIGHT_OFFSETS = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0)]
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Clusters:
     """Frontier clusters of one belief grid.
 

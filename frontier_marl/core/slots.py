@@ -15,7 +15,7 @@ Rules (open choices of the thesis, documented in docs/thesis-mapping.md):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,25 +25,15 @@ from frontier_marl.core.frontiers import Clusters
 from frontier_marl.core.grid import FREE
 from frontier_marl.core.planning import distance_field
 
-_ARRAYS = (
-    "cluster",
-    "valid",
-    "centroid",
-    "target",
-    "distance",
-    "size",
-    "gain",
-    "path_length",
-    "mask",
-)
+_ARRAYS = ("cluster", "valid", "centroid", "target", "distance", "size", "gain", "path_length")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False, slots=True)
 class SlotTable:
     """One robot's slots. Arrays have length ``n_slots``; padding rows hold zeros and -1.
 
     A table is built once per decision and shared (by the observation, the info and the action
-    mask), so its arrays are read-only.
+    mask): treat its arrays as read-only.
     """
 
     cluster: np.ndarray  # int (n,), cluster index or -1 for padding
@@ -54,33 +44,25 @@ class SlotTable:
     size: np.ndarray  # int (n,)
     gain: np.ndarray  # float (n,)
     path_length: np.ndarray  # int (n,), known-free shortest path robot -> target, -1 padding
+    mask: np.ndarray  # int8 (n,): the live slots, or slot 0 (the idle action) if none is live
     live: int  # how many slots hold a cluster (the first ``live`` ones)
-    mask: np.ndarray = field(init=False)  # int8 (n,): the live slots, or slot 0 if none
 
-    def __post_init__(self) -> None:
-        mask = self.valid.astype(np.int8)
-        if not self.live:
-            mask[0] = 1  # no live cluster: slot 0 is the idle action
-        object.__setattr__(self, "mask", mask)
-        for array in (
-            self.cluster,
-            self.valid,
-            self.centroid,
-            self.target,
-            self.distance,
-            self.size,
-            self.gain,
-            self.path_length,
-            mask,
-        ):
-            array.flags.writeable = False
+    @classmethod
+    def from_arrays(cls, **arrays: np.ndarray) -> SlotTable:
+        """A table from the arrays of :data:`_ARRAYS` (live slots first), with its ``live``
+        count and action mask derived."""
+        live = int(np.count_nonzero(arrays["valid"]))
+        mask = np.asarray(arrays["valid"], dtype=np.int8).copy()
+        if not live:
+            mask[0] = 1
+        return cls(**arrays, mask=mask, live=live)
 
     def __eq__(self, other: object) -> bool:
         """Equal when every field is: same live count and identical arrays."""
         if not isinstance(other, SlotTable):
             return NotImplemented
         return self.live == other.live and all(
-            np.array_equal(getattr(self, name), getattr(other, name)) for name in _ARRAYS
+            np.array_equal(getattr(self, name), getattr(other, name)) for name in (*_ARRAYS, "mask")
         )
 
     __hash__ = None  # type: ignore[assignment]  # mutable-looking arrays: not hashable
@@ -116,7 +98,7 @@ def robot_slots(
     sort_by_distance: bool,
 ) -> SlotTable:
     """The slots of the robot standing at ``position`` (row, col) on ``belief``."""
-    arrays = _robot_slots(
+    *arrays, live = _robot_slots(
         belief,
         int(position[0]),
         int(position[1]),
@@ -129,7 +111,7 @@ def robot_slots(
         n_slots,
         sort_by_distance,
     )
-    return SlotTable(*arrays, live=int(np.count_nonzero(arrays[1])))
+    return SlotTable(*arrays, live=live)
 
 
 @compiled
@@ -177,9 +159,18 @@ def _robot_slots(
     n_slots: int,
     sort: bool,
 ) -> tuple[
-    np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    int,
 ]:
-    """The arrays of :class:`SlotTable` for the robot at (row, col): reachability and path
+    """The fields of :class:`SlotTable` for the robot at (row, col): reachability and path
     lengths from one distance field, targets, selection of the nearest, order, padding."""
     field = distance_field(belief, FREE, row, col)
     eligible = np.empty(len(rows), dtype=np.bool_)
@@ -218,4 +209,8 @@ def _robot_slots(
         size[slot] = sizes[k]
         gain[slot] = gains[k]
         path_length[slot] = field[targets[k, 0], targets[k, 1]]
-    return cluster, valid, centroid, target, slot_distance, size, gain, path_length
+    mask = np.zeros(n_slots, dtype=np.int8)
+    mask[: len(live)] = 1
+    if len(live) == 0:
+        mask[0] = 1
+    return cluster, valid, centroid, target, slot_distance, size, gain, path_length, mask, len(live)

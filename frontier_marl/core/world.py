@@ -35,7 +35,7 @@ class WorldParams:
     gain: str = "size"  # or "unknown"
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class MoveResult:
     """What one transition did, per robot (arrays owned by the result)."""
 
@@ -226,12 +226,11 @@ class World:
             for agent, target in enumerate(targets):
                 self._goals[agent] = (-1, -1) if target is None else target
         self._walk()
-        longest = int(self._walked_len.max())
+        walked = self._walked
+        if walked.shape[1] > 16:  # a whole-path buffer: copy only the cells walked
+            walked = walked[:, : int(self._walked_len.max())]
         return MoveResult(
-            self._new_cells.copy(),
-            self._walked[:, :longest].copy(),
-            self._walked_len.copy(),
-            self._reached.copy(),
+            self._new_cells.copy(), walked.copy(), self._walked_len.copy(), self._reached.copy()
         )
 
     def _walk(self) -> None:

@@ -1,0 +1,149 @@
+"""The same speed measurements on two revisions of the package, alternated in one run.
+
+    python benchmarks/bench_revisions.py BEFORE_TREE [AFTER_TREE] --rounds 3 --json out.json
+
+``BEFORE_TREE`` and ``AFTER_TREE`` (default: this checkout) are source trees of the package, e.g.
+``git worktree add /tmp/before <commit>``. Each round runs every measurement once per tree, in
+a fresh process whose ``PYTHONPATH`` puts that tree first, alternating the order from round to
+round so that the drift of a shared machine hits both alike. Measurements, all on
+thesis-20x20 with one robot and random valid actions:
+
+* ``step_us``: microseconds per ``step`` (resets not timed) of ``FrontierExploreEnv`` with its
+  default infos, and ``step_us_training``: the same with the infos training uses
+  (``info="minimal"`` where the tree has it);
+* ``env_share``: the share of thesis-DQN training time spent in the env (training infos),
+  against a null env with the same spaces, interleaved in chunks within one process
+  (``bench_env.train_interleaved``).
+
+The report gives each figure's mean over the rounds per tree and the after/before ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+
+
+def make_env(training: bool) -> Any:
+    import frontier_marl
+
+    if training:
+        try:
+            return frontier_marl.FrontierExploreEnv(preset="thesis-20x20", info="minimal")
+        except ValueError:  # a tree without info levels: its only infos are the full ones
+            pass
+    return frontier_marl.FrontierExploreEnv(preset="thesis-20x20")
+
+
+def step_us(training: bool, steps: int) -> float:
+    import numpy as np
+
+    env = make_env(training)
+    rng = np.random.default_rng(0)
+    _, info = env.reset(seed=0)
+    for _ in range(200):  # warm-up: compiled kernels, caches
+        _, _, terminated, truncated, info = env.step(
+            int(rng.choice(np.flatnonzero(info["action_mask"])))
+        )
+        if terminated or truncated:
+            _, info = env.reset()
+    elapsed, seed = 0.0, 1
+    for _ in range(steps):
+        action = int(rng.choice(np.flatnonzero(info["action_mask"])))
+        start = time.perf_counter()
+        _, _, terminated, truncated, info = env.step(action)
+        elapsed += time.perf_counter() - start
+        if terminated or truncated:
+            _, info = env.reset(seed=seed)
+            seed += 1
+    return 1e6 * elapsed / steps
+
+
+def env_share(steps: int, chunks: int) -> float:
+    sys.path.insert(0, str(HERE))
+    from bench_env import NullEnv, train_interleaved
+
+    env = make_env(training=True)
+    seconds = train_interleaved({"null": NullEnv(env), "env": env}, steps, chunks)
+    null, real = sum(seconds["null"]), sum(seconds["env"])
+    return (real - null) / real
+
+
+def worker(args: argparse.Namespace) -> None:
+    import frontier_marl
+
+    report = {
+        "package": frontier_marl.__file__,
+        "step_us": step_us(False, args.steps),
+        "step_us_training": step_us(True, args.steps),
+        "env_share": env_share(args.dqn_steps, args.dqn_chunks),
+    }
+    print(json.dumps(report))
+
+
+def measure(tree: Path, args: argparse.Namespace) -> dict[str, Any]:
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    command = [sys.executable, __file__, "--worker", "--steps", str(args.steps)]
+    command += ["--dqn-steps", str(args.dqn_steps), "--dqn-chunks", str(args.dqn_chunks)]
+    done = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    if not Path(report["package"]).is_relative_to(tree):
+        raise RuntimeError(f"{tree}: the worker imported {report['package']}")
+    return report
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("before", type=Path, nargs="?")
+    parser.add_argument("after", type=Path, nargs="?", default=HERE.parent)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--steps", type=int, default=20_000, help="timed env steps")
+    parser.add_argument("--dqn-steps", type=int, default=30_000)
+    parser.add_argument("--dqn-chunks", type=int, default=10)
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        worker(args)
+        return
+    if args.before is None:
+        parser.error("give the source tree of the revision to compare with")
+    trees = {"before": args.before.resolve(), "after": args.after.resolve()}
+    runs: dict[str, list[dict[str, Any]]] = {name: [] for name in trees}
+    for round_index in range(args.rounds):
+        order = list(trees) if round_index % 2 == 0 else list(reversed(trees))
+        for name in order:
+            runs[name].append(measure(trees[name], args))
+            print(f"round {round_index + 1}, {name}: {runs[name][-1]}", file=sys.stderr)
+    keys = ("step_us", "step_us_training", "env_share")
+    means = {
+        name: {k: sum(r[k] for r in rows) / len(rows) for k in keys} for name, rows in runs.items()
+    }
+    report = {
+        "trees": {name: str(tree) for name, tree in trees.items()},
+        "rounds": args.rounds,
+        "steps": args.steps,
+        "dqn_steps": args.dqn_steps,
+        "runs": runs,
+        "mean": means,
+        "ratio_after_before": {k: means["after"][k] / means["before"][k] for k in keys},
+    }
+    for k in keys:
+        print(
+            f"{k:<18} before {means['before'][k]:8.3f}  after {means['after'][k]:8.3f}  "
+            f"ratio {report['ratio_after_before'][k]:.3f}"
+        )
+    if args.json is not None:
+        args.json.write_text(json.dumps(report, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
