@@ -15,7 +15,8 @@ thesis-20x20 with one robot and random valid actions:
   against a null env with the same spaces, interleaved in chunks within one process
   (``bench_env.train_interleaved``).
 
-The report gives each figure's mean over the rounds per tree and the after/before ratio.
+The report gives each figure's median and minimum over the rounds per tree and the ratio of
+the medians (``--dqn-steps 0`` leaves the training share out, for quick step timings).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -84,8 +86,9 @@ def worker(args: argparse.Namespace) -> None:
         "package": frontier_marl.__file__,
         "step_us": step_us(False, args.steps),
         "step_us_training": step_us(True, args.steps),
-        "env_share": env_share(args.dqn_steps, args.dqn_chunks),
     }
+    if args.dqn_steps > 0:
+        report["env_share"] = env_share(args.dqn_steps, args.dqn_chunks)
     print(json.dumps(report))
 
 
@@ -123,9 +126,13 @@ def main() -> None:
         for name in order:
             runs[name].append(measure(trees[name], args))
             print(f"round {round_index + 1}, {name}: {runs[name][-1]}", file=sys.stderr)
-    keys = ("step_us", "step_us_training", "env_share")
-    means = {
-        name: {k: sum(r[k] for r in rows) / len(rows) for k in keys} for name, rows in runs.items()
+    keys = [k for k in ("step_us", "step_us_training", "env_share") if k in runs["after"][0]]
+    stats = {
+        name: {
+            k: {"median": statistics.median(r[k] for r in rows), "min": min(r[k] for r in rows)}
+            for k in keys
+        }
+        for name, rows in runs.items()
     }
     report = {
         "trees": {name: str(tree) for name, tree in trees.items()},
@@ -133,13 +140,17 @@ def main() -> None:
         "steps": args.steps,
         "dqn_steps": args.dqn_steps,
         "runs": runs,
-        "mean": means,
-        "ratio_after_before": {k: means["after"][k] / means["before"][k] for k in keys},
+        "stats": stats,
+        "median_ratio_after_before": {
+            k: stats["after"][k]["median"] / stats["before"][k]["median"] for k in keys
+        },
     }
     for k in keys:
+        before, after = stats["before"][k], stats["after"][k]
         print(
-            f"{k:<18} before {means['before'][k]:8.3f}  after {means['after'][k]:8.3f}  "
-            f"ratio {report['ratio_after_before'][k]:.3f}"
+            f"{k:<18} median before {before['median']:8.3f} after {after['median']:8.3f} "
+            f"(ratio {after['median'] / before['median']:.3f}); min before {before['min']:8.3f} "
+            f"after {after['min']:8.3f}"
         )
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=1) + "\n")

@@ -52,17 +52,18 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
     new_cells = [0] * n if result is None else result.move.new_cells.tolist()
     reason = "" if result is None else result.outcome.reason
     common = {"explored_fraction": fraction, "coverage": coverage, "step": mdp.steps}
+    infos = [
+        StepInfo(
+            common,
+            new_cells=new_cells[agent],
+            action_mask=tables[agent].mask,
+            travelled=travelled[agent],
+            end_reason=reason,
+        )
+        for agent in range(n)
+    ]
     if level == "minimal":
-        return [
-            StepInfo(
-                common,
-                new_cells=new_cells[agent],
-                action_mask=tables[agent].mask,
-                travelled=travelled[agent],
-                end_reason=reason,
-            )
-            for agent in range(n)
-        ]
+        return infos
     positions = [tuple(cell) for cell in world.positions.tolist()]
     if result is None:
         paths = [world.positions[agent][None, :].copy() for agent in range(n)]
@@ -72,19 +73,13 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
         paths = result.move.paths
         targets = [None if row < 0 else (row, col) for row, col in result.targets.tolist()]
         padding, oscillation = result.padding.tolist(), result.oscillation.tolist()
-    return [
-        StepInfo(
-            common,
-            new_cells=new_cells[agent],
-            action_mask=tables[agent].mask,
+    for agent, info in enumerate(infos):
+        info.update(
             slots=tables[agent],
             path=paths[agent],
             target=targets[agent],
             position=positions[agent],
-            travelled=travelled[agent],
             padding=padding[agent],
             oscillation=oscillation[agent],
-            end_reason=reason,
         )
-        for agent in range(n)
-    ]
+    return infos
