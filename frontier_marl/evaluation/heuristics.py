@@ -91,6 +91,7 @@ class RandomValid(HeuristicPolicy):
     deterministic = False
 
     def __init__(self, seed: int | None = None) -> None:
+        super().__init__()
         self._rng = np.random.default_rng(seed)
 
     def reset(self, seed: int | None = None) -> None:

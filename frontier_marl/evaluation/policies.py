@@ -60,14 +60,53 @@ class Policy:
         return f"{type(self).__name__}(name={self.name!r})"
 
 
+#: ``commit`` values of the heuristics: re-decide every step (the thesis's greedy rule), or
+#: keep the previous target while the last step revealed no new cell.
+COMMIT_RULES: tuple[str, ...] = ("none", "until-progress")
+
+
+def check_commit(commit: str) -> str:
+    if commit not in COMMIT_RULES:
+        raise ValueError(f"commit must be one of {list(COMMIT_RULES)}, got {commit!r}")
+    return commit
+
+
 class HeuristicPolicy(Policy):
-    """A policy that applies :meth:`choose` to each robot's info independently."""
+    """A policy that applies :meth:`choose` to each robot's info independently.
+
+    Args:
+        commit: ``none`` re-decides at every step. ``until-progress`` keeps the target the robot
+            headed for in the last step (``info["target"]``) while that step revealed no new
+            cell (``info["new_cells"] == 0``) and the target is still offered in a slot: the
+            clusters have not changed, so the robot walks on instead of turning back and forth
+            between two clusters (docs/calibration.md, "Livelocks").
+    """
+
+    def __init__(self, commit: str = "none") -> None:
+        self.commit = check_commit(commit)
 
     def act(self, obs: Any, info: Info) -> int:
+        if self.commit == "until-progress":
+            kept = kept_slot(info)
+            if kept is not None:
+                return kept
         return int(self.choose(info))
 
     def choose(self, info: Info) -> int:
         raise NotImplementedError
+
+
+def kept_slot(info: Info) -> int | None:
+    """The slot of the robot's previous target when its last step revealed nothing and the
+    target is still offered, else ``None``."""
+    previous = info.get("target")
+    if previous is None or info["new_cells"]:
+        return None
+    table = slot_table(info)
+    for slot in range(table.live):
+        if (table.target[slot, 0], table.target[slot, 1]) == previous:
+            return slot
+    return None
 
 
 def slot_table(info: Info) -> SlotTable:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import inspect
+from typing import Any
+
 from frontier_marl.evaluation.heuristics import (
     CostUtility,
     FirstSlot,
@@ -27,10 +30,18 @@ POLICIES: dict[str, type[Policy]] = {
 TEAM_POLICIES: tuple[str, ...] = ("coordinated-assignment", "utility-discount")
 
 
-def make_policy(name: str, seed: int | None = None) -> Policy:
-    """A fresh heuristic by name; ``seed`` seeds the random policy (ignored by the others)."""
+def make_policy(name: str, seed: int | None = None, **options: Any) -> Policy:
+    """A fresh heuristic by name; ``seed`` seeds the random policy (ignored by the others);
+    ``options`` go to its constructor (e.g. ``commit="until-progress"``)."""
     if name not in POLICIES:
         raise ValueError(f"policy must be one of {list(POLICIES)}, got {name!r}")
-    policy = POLICIES[name]()
+    cls = POLICIES[name]
+    accepted = set(inspect.signature(cls).parameters)
+    unknown = sorted(set(options) - accepted)
+    if unknown:
+        raise ValueError(
+            f"policy {name!r} has no option {unknown[0]!r} (options: {sorted(accepted) or 'none'})"
+        )
+    policy = cls(**options)
     policy.reset(seed)
     return policy
