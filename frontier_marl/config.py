@@ -28,6 +28,7 @@ from frontier_marl.checks import (
 CentroidEncoding = Literal["absolute", "relative", "distance", "none"]
 MapMode = Literal["static", "dynamic"]
 MapGenerator = Literal["random", "rooms"]
+StartCells = Literal["largest-component", "any-free"]
 SensorModel = Literal["square", "raycast"]
 GainModel = Literal["size", "unknown"]
 ThresholdBasis = Literal["all", "free", "reachable"]
@@ -38,6 +39,7 @@ FULL_PATH = "full"
 _CENTROIDS = ("absolute", "relative", "distance", "none")
 _MAP_MODES = ("static", "dynamic")
 _GENERATORS = ("random", "rooms")
+_START_CELLS = ("largest-component", "any-free")
 _SENSORS = ("square", "raycast")
 _GAINS = ("size", "unknown")
 _BASES = ("all", "free", "reachable")
@@ -173,6 +175,14 @@ class EnvConfig:
             (rectangular rooms joined by corridors; ``obstacle_prob`` is not used).
         obstacle_prob: probability that a cell is an obstacle (open choice; 0.1 by
             calibration against the thesis's 20x20 baselines, docs/calibration.md).
+        obstacle_prob_spread: draw each dynamic random layout's obstacle probability
+            uniformly from ``obstacle_prob`` +- this, clipped to [0, 0.9] (open choice; 0.2,
+            so U(0, 0.3) around the 0.1 default: the setting that gives dynamic maps the
+            thesis's lower means and wider spread, docs/calibration.md); 0 keeps it fixed.
+            The static layout always uses ``obstacle_prob``.
+        start_cells: where robots start: ``largest-component`` (distinct random cells of the
+            largest 4-connected free component) or ``any-free`` (of all free cells, so a robot
+            may start in a small pocket; the reachable region is then the pocket). Open choice.
         map_mode: ``static`` (one layout from ``map_seed``) or ``dynamic`` (new layout per reset).
         map_seed: seed of the static layout, recorded so results are comparable across runs.
         map_path: load the (static) layout from a .txt, .pgm or .png file instead of drawing
@@ -197,6 +207,8 @@ class EnvConfig:
     n_agents: int = 1
     map_generator: MapGenerator = "random"
     obstacle_prob: float = 0.1
+    obstacle_prob_spread: float = 0.2
+    start_cells: StartCells = "largest-component"
     map_mode: MapMode = "static"
     map_seed: int = 0
     map_path: str | None = None
@@ -220,6 +232,8 @@ class EnvConfig:
         check_int("n_agents", self.n_agents, 1, 64)
         check_choice("map_generator", self.map_generator, _GENERATORS)
         check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
+        check_range("obstacle_prob_spread", self.obstacle_prob_spread, 0.0, 0.5)
+        check_choice("start_cells", self.start_cells, _START_CELLS)
         if self.map_generator == "rooms" and min(self.height, self.width) < 5:
             raise ValueError(
                 f"map_generator='rooms' needs height and width >= 5, got {self.height}x{self.width}"

@@ -105,19 +105,28 @@ class ExplorationMDP:
         cfg = self.cfg
         if cfg.map_generator == "rooms":
             return rooms_map(cfg.height, cfg.width, rng)
-        return random_obstacle_map(cfg.height, cfg.width, cfg.obstacle_prob, rng)
+        density = cfg.obstacle_prob
+        if cfg.obstacle_prob_spread > 0 and cfg.map_mode == "dynamic":
+            low = max(0.0, density - cfg.obstacle_prob_spread)
+            density = float(rng.uniform(low, min(0.9, density + cfg.obstacle_prob_spread)))
+        return random_obstacle_map(cfg.height, cfg.width, density, rng)
 
     def reset(self, rng: np.random.Generator) -> list[Observation]:
-        """Start an episode: map, start cells in the largest free component, first sensing."""
+        """Start an episode: map, start cells (``start_cells``), first sensing."""
         cfg = self.cfg
         true_grid = self.true_grid_for_episode(rng)
         if true_grid is not self._region_grid:  # a static map keeps its start region
             self._region_grid = true_grid
-            self._start_region = largest_free_component(true_grid)
+            if cfg.start_cells == "any-free":
+                self._start_region = ~true_grid
+            else:
+                self._start_region = largest_free_component(true_grid)
             self._start_region.setflags(write=False)
         starts = sample_start_cells(self._start_region, cfg.n_agents, rng)
-        # Starts lie in one 4-connected component, so it is the region reachable from them.
-        self.world = World(true_grid, starts, self.params, self._start_region)
+        if cfg.start_cells == "any-free":  # the world finds the region reachable from them
+            self.world = World(true_grid, starts, self.params)
+        else:  # starts in one 4-connected component: it is the region reachable from them
+            self.world = World(true_grid, starts, self.params, self._start_region)
         self._oscillation = [
             OscillationDetector(cfg.reward.oscillation_window) for _ in range(cfg.n_agents)
         ]

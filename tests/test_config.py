@@ -34,6 +34,9 @@ BAD_VALUES = [
     ("obstacle_prob", 0.95, "obstacle_prob"),
     ("obstacle_prob", math.nan, "obstacle_prob"),
     ("obstacle_prob", "low", "obstacle_prob"),
+    ("obstacle_prob_spread", 0.6, "obstacle_prob_spread"),
+    ("obstacle_prob_spread", -0.1, "obstacle_prob_spread"),
+    ("start_cells", "corner", "start_cells"),
     ("map_mode", "moving", "map_mode"),
     ("map_seed", -1, "map_seed"),
     ("map_seed", 0.5, "map_seed"),
@@ -305,3 +308,30 @@ def test_config_to_dict_round_trip(kwargs, preset):
     assert set(flat) == set(config_keys()) - {"preset", "config"}
     assert make_config(config=None, preset=preset, **flat) == cfg
     assert config_to_dict(make_config(config=None, preset=preset, **flat)) == flat
+
+
+def test_start_cells_and_obstacle_spread_are_validated_and_used():
+    with pytest.raises(ValueError, match="start_cells"):
+        make_config(start_cells="corner")
+    with pytest.raises(ValueError, match="obstacle_prob_spread"):
+        make_config(obstacle_prob_spread=0.6)
+    import frontier_marl
+
+    env = frontier_marl.parallel_env(map_mode="dynamic", obstacle_prob_spread=0.1)
+    densities = set()
+    for seed in range(8):
+        env.reset(seed=seed)
+        densities.add(round(float(env.world.true_grid.mean()), 3))
+    assert len(densities) == 8 and min(densities) < 0.06 and max(densities) > 0.14
+    spread, plain = (frontier_marl.parallel_env(obstacle_prob_spread=s) for s in (0.1, 0.0))
+    spread.reset(seed=0)
+    plain.reset(seed=0)
+    np.testing.assert_array_equal(spread.world.true_grid, plain.world.true_grid)  # static
+    pocket = frontier_marl.parallel_env(start_cells="any-free", obstacle_prob=0.4)
+    sizes = set()
+    for seed in range(40):
+        pocket.reset(seed=seed)
+        region = pocket.world.start_region
+        assert region[tuple(pocket.world.positions[0])]
+        sizes.add(int(region.sum()))
+    assert min(sizes) < 10  # some start in a small pocket

@@ -375,6 +375,7 @@ def test_cluster_features_encode_the_slot_table(centroid: str, normalize: bool) 
         normalize=normalize,
         n_slots=5,
         map_mode="dynamic",
+        obstacle_prob_spread=0.0,  # the layouts this test's seed was chosen on
     )
     scale = {
         "absolute": [height, width],

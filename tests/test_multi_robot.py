@@ -741,3 +741,22 @@ def test_pettingzoo_suites_with_teams_on_structured_maps(kwargs, n_agents):
         parallel_seed_test(lambda: frontier_marl.parallel_env(**kwargs), num_cycles=100)
     env = frontier_marl.parallel_env(**kwargs)
     assert env.possible_agents == [f"robot_{i}" for i in range(n_agents)]
+
+
+def test_team_commit_keeps_each_robot_on_its_target_after_a_step_without_progress():
+    # Robot 0 heads for A (col 8) but B (col 0) is nearer now; robot 1 heads nowhere. Without
+    # progress, robot 0 keeps A and robot 1 gets the other cluster.
+    belief = np.full((1, 9), FREE, np.int8)
+    clusters = [(0, (0, 0)), (1, (0, 8))]
+    infos = {
+        "robot_0": {**free_info(clusters, (0, 3), belief), "target": (0, 8), "new_cells": 0},
+        "robot_1": {**free_info(clusters, (0, 4), belief), "target": None, "new_cells": 0},
+    }
+    obs = dict.fromkeys(infos)
+    for name in TEAM_POLICIES:
+        kwargs = {"sensor_range": 2} if name == "utility-discount" else {}
+        policy = make_policy(name, commit="until-progress", **kwargs)
+        assert policy.act_team(obs, infos) == {"robot_0": 1, "robot_1": 0}, name
+        progressed = {a: {**i, "new_cells": 1} for a, i in infos.items()}
+        fresh = make_policy(name, **kwargs).act_team(obs, progressed)
+        assert policy.act_team(obs, progressed) == fresh, name

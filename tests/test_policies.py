@@ -211,3 +211,43 @@ def test_heuristic_drives_the_gymnasium_env():
         obs, _, terminated, truncated, info = env.step(action)
         done = terminated or truncated
     assert info["end_reason"] == "threshold"
+
+
+# ----------------------------------------------------------------- commitment (livelocks)
+
+
+def test_commit_keeps_the_previous_target_while_nothing_new_was_seen() -> None:
+    live = [live_slot(1, 2.0, target=(0, 1)), live_slot(1, 1.0, target=(0, 2))]
+    policy = GreedyDistance(commit="until-progress")
+    stuck = info_with(live, target=(0, 1), new_cells=0)
+    assert GreedyDistance().act(None, stuck) == 1  # the nearest centroid
+    assert policy.act(None, stuck) == 0  # walks on to (0, 1)
+    assert policy.act(None, {**stuck, "new_cells": 3}) == 1  # progress: decide afresh
+    assert policy.act(None, {**stuck, "target": (5, 5)}) == 1  # no longer offered
+    assert policy.act(None, {**stuck, "target": None}) == 1  # no previous target
+
+
+def test_policy_options_are_checked() -> None:
+    assert make_policy("greedy-gain", commit="until-progress").commit == "until-progress"
+    assert make_policy("coordinated-assignment", commit="until-progress").commit == "until-progress"
+    with pytest.raises(ValueError, match="commit"):
+        make_policy("greedy-distance", commit="forever")
+    with pytest.raises(ValueError, match="no option 'beta'"):
+        make_policy("greedy-distance", beta=2.0)
+
+
+@pytest.mark.parametrize("commit", ["none", "until-progress"])
+def test_the_thesis_30x30_livelock_and_its_fix(commit: str) -> None:
+    """Greedy distance on thesis-30x30, static, seed 16: turning back and forth between two
+    clusters ends the episode by the no-progress rule at 37 % coverage; committing to the
+    target until something new is seen reaches the threshold."""
+    from frontier_marl.evaluation import evaluate
+
+    result = evaluate(
+        {"preset": "thesis-30x30"}, make_policy("greedy-distance", commit=commit), 1, seed=16
+    )
+    (episode,) = result.episodes
+    if commit == "none":
+        assert episode.end_reason == "no_progress" and episode.coverage < 0.4
+    else:
+        assert episode.end_reason == "threshold"

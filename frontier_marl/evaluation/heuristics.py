@@ -14,6 +14,10 @@ state:
 * ``random``: uniform over the valid slots of ``action_mask``, from its own seeded generator.
 * ``first-slot``: always slot 0, the thesis's degenerate policy as a baseline (greedy distance
   when slots are sorted; the top-most of the selected clusters when unsorted).
+
+Every heuristic but ``random`` takes ``commit`` (:class:`~frontier_marl.evaluation.policies.
+HeuristicPolicy`): ``none`` re-decides at every step; ``until-progress`` keeps the previous
+target while the last step revealed nothing.
 """
 
 from __future__ import annotations

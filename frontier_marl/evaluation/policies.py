@@ -99,8 +99,13 @@ class HeuristicPolicy(Policy):
 def kept_slot(info: Info) -> int | None:
     """The slot of the robot's previous target when its last step revealed nothing and the
     target is still offered, else ``None``."""
+    return None if info["new_cells"] else previous_target_slot(info)
+
+
+def previous_target_slot(info: Info) -> int | None:
+    """The slot offering the target the robot headed for in its last step, if any."""
     previous = info.get("target")
-    if previous is None or info["new_cells"]:
+    if previous is None:
         return None
     table = slot_table(info)
     for slot in range(table.live):

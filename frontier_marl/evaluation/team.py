@@ -24,6 +24,10 @@ path lengths.
   ``perception_range``, read by :meth:`Policy.attach`, or ``sensor_range=``). ``beta = 1``. A
   claimed target drops to utility 0 for the others, so duplicates are discouraged but not
   forbidden. With one robot: its nearest cluster by path length, as ``coordinated-assignment``.
+
+Both take ``commit`` as the single-robot heuristics do: with ``until-progress``, after a step in
+which no robot revealed a cell, every robot whose previous target is still offered keeps it,
+and the others are decided jointly among the remaining clusters.
 """
 
 from __future__ import annotations
@@ -33,7 +37,13 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.evaluation.policies import Info, Policy, slot_table
+from frontier_marl.evaluation.policies import (
+    Info,
+    Policy,
+    check_commit,
+    previous_target_slot,
+    slot_table,
+)
 
 
 class _Option:
@@ -54,8 +64,9 @@ class TeamHeuristic(Policy):
     :meth:`act` treats one robot as a team of one.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, commit: str = "none") -> None:
         self._config: Any = None
+        self.commit = check_commit(commit)
 
     def attach(self, env: Any) -> None:
         self._config = getattr(getattr(env, "unwrapped", env), "config", None)
@@ -88,12 +99,40 @@ class TeamHeuristic(Policy):
         self, observations: Mapping[str, Any], infos: Mapping[str, Info]
     ) -> dict[str, int]:
         agents = list(observations)
-        options = self.options([infos[agent] for agent in agents])
-        chosen = self.choose_team(options)
+        team = [infos[agent] for agent in agents]
+        options = self.options(team)
+        kept: list[int | None] = [None] * len(team)
+        if self.commit == "until-progress" and not any(info["new_cells"] for info in team):
+            kept = [previous_target_slot(info) for info in team]
+        chosen = self._choose_around(options, kept)
         return {
             agent: (0 if pick is None else pick.slot)
             for agent, pick in zip(agents, chosen, strict=True)
         }
+
+    def _choose_around(
+        self, options: list[list[_Option]], kept: list[int | None]
+    ) -> list[_Option | None]:
+        """:meth:`choose_team` for the robots without a kept slot, the kept robots' clusters
+        taken out of their options (unless that leaves a robot nothing)."""
+        if all(slot is None for slot in kept):
+            return self.choose_team(options)
+        fixed = {i: options[i][slot] for i, slot in enumerate(kept) if slot is not None}
+        taken = {o.cluster for o in fixed.values()}
+        free = [i for i in range(len(options)) if i not in fixed]
+        rest = [
+            [
+                _Option(j, o.cluster, o.slot, o.length, o.target)  # numbered within ``rest``
+                for o in ([o for o in options[i] if o.cluster not in taken] or options[i])
+            ]
+            for j, i in enumerate(free)
+        ]
+        chosen: list[_Option | None] = [None] * len(options)
+        for i, pick in zip(free, self.choose_team(rest) if free else [], strict=True):
+            chosen[i] = pick
+        for i, pick in fixed.items():
+            chosen[i] = pick
+        return chosen
 
     def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
         """One option (or ``None``: idle on slot 0) per robot."""
@@ -156,8 +195,10 @@ class UtilityDiscount(TeamHeuristic):
 
     name = "utility-discount"
 
-    def __init__(self, beta: float = 1.0, sensor_range: float | None = None) -> None:
-        super().__init__()
+    def __init__(
+        self, beta: float = 1.0, sensor_range: float | None = None, commit: str = "none"
+    ) -> None:
+        super().__init__(commit)
         if not np.isfinite(beta) or beta < 0:
             raise ValueError(f"beta must be a finite number >= 0, got {beta!r}")
         if sensor_range is not None and not (np.isfinite(sensor_range) and sensor_range > 0):
