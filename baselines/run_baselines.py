@@ -1,6 +1,7 @@
 """Run the heuristic baselines on the four thesis settings (20x20 / 30x30 x static / dynamic).
 
-Writes ``baselines/results/<preset>-<map mode>.json`` and ``.png`` per setting, and
+Writes ``baselines/results/<preset>-<map mode>.json`` (the rows with per-episode records,
+without per-step curves) and ``.png`` per setting, and
 ``baselines/results/summary.md`` with every table. Usage::
 
     python baselines/run_baselines.py                 # 30 episodes, seed 0 (a minute or two)
@@ -18,7 +19,12 @@ import time
 from pathlib import Path
 
 from frontier_marl.cli import main as cli_main
-from frontier_marl.workflows.baselines import DEFAULT_POLICIES, format_table
+from frontier_marl.workflows.baselines import (
+    DEFAULT_POLICIES,
+    dumps_rows,
+    format_table,
+    without_curves,
+)
 
 SETTINGS = [
     ("thesis-20x20", "static"),
@@ -67,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
         if code:
             return code
         seconds = time.perf_counter() - start
-        rows = json.loads(Path(f"{stem}.json").read_text())
+        rows = [without_curves(row) for row in json.loads(Path(f"{stem}.json").read_text())]
+        Path(f"{stem}.json").write_text(dumps_rows(rows))  # the figures, not the curves
         sections.append(
             f"## {preset}, {mode} map ({args.episodes} episodes, seed {args.seed}, "
             f"{seconds:.0f} s)\n\n```\n{format_table(rows)}\n```\n"

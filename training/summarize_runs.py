@@ -24,19 +24,12 @@ from typing import Any
 
 from frontier_marl.json_files import write_json
 from frontier_marl.training.callbacks import read_metrics
-
-#: Per-episode keys dropped from the evaluation rows (per-step curves).
-CURVE_KEYS = ("curve", "makespan_curve")
+from frontier_marl.workflows.baselines import without_curves
 
 
 def strip_curves(row: dict[str, Any]) -> dict[str, Any]:
     """An evaluation row without its resolved env config and per-step curves."""
-    out = {k: v for k, v in row.items() if k != "config"}
-    out["per_episode"] = [
-        {k: v for k, v in episode.items() if k not in CURVE_KEYS}
-        for episode in row.get("per_episode", [])
-    ]
-    return out
+    return {k: v for k, v in without_curves(row).items() if k != "config"}
 
 
 def evaluation_summary(path: Path) -> dict[str, Any] | None:

@@ -139,6 +139,19 @@ def describe(env_kwargs: dict[str, Any], episodes: int, seed: int) -> str:
     )
 
 
+#: Per-episode keys of the per-step coverage curves (left out of results kept in the tree).
+CURVE_KEYS = ("curve", "makespan_curve")
+
+
+def without_curves(row: dict[str, Any]) -> dict[str, Any]:
+    """An evaluation row with its per-episode records but without their per-step curves."""
+    episodes = [
+        {k: v for k, v in episode.items() if k not in CURVE_KEYS}
+        for episode in row.get("per_episode", [])
+    ]
+    return {**row, "per_episode": episodes}
+
+
 def dumps_rows(rows: Sequence[dict[str, Any]]) -> str:
     """JSON text of the rows: summary fields indented, one compact line per episode."""
     parts = []
