@@ -15,8 +15,8 @@ from pathlib import Path
 #: name -> one-line description
 PRETRAINED: dict[str, str] = {
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
-    "Reward 2, normalized), the best-validated policy of a 1e6-step run on thesis-20x20 "
-    "(seed 0, step 500,000)",
+    "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
+    "frontier-marl reproduce run, the seed whose protocol score is the median of the three",
 }
 
 

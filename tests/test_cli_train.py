@@ -201,11 +201,11 @@ def test_evaluate_the_shipped_model_by_name(tmp_path: Path, capsys) -> None:
     )
     assert code == 0
     result = json.loads(out_json.read_text())
-    # The best-validated policy of a 1e6-step run (chosen at step 500,000).
-    assert result["num_timesteps"] == 500_000
+    # The best-validated policy of a 1e6-step run (chosen at step 340,000).
+    assert result["num_timesteps"] == 340_000
     assert result["env_config"]["height"] == 20
     meta = json.loads((pretrained_model_dir("thesis-config01") / "model.json").read_text())
     assert meta["experiment"]["train"]["total_timesteps"] == 1_000_000
-    assert meta["validation"]["step"] == 500_000 and meta["validation"]["seed"] == 1000
+    assert meta["validation"]["step"] == 340_000 and meta["validation"]["seed"] == 1000
     (model,) = result["rows"]
     assert model["episodes"] == 2 and sum(model["action_shares"]) == pytest.approx(1.0)
