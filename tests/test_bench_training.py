@@ -71,12 +71,3 @@ def test_env_share_interleaves_equal_runs() -> None:
     assert report["env_share"] == expected
     assert len(report["env_share_by_chunk"]) == 3
     assert report["env_share_standard_error"] >= 0
-
-
-def test_minimal_step_plays_the_real_episodes() -> None:
-    """The floor benchmark's minimal step is faithful: the real env's episodes, exactly."""
-    module = runpy.run_path(str(REPO / "benchmarks" / "bench_step_floor.py"))
-    assert module["check_same_episodes"](3) > 20
-    report = module["training_shares"](400, 2)
-    assert report["steps"] == 400
-    assert set(report["env_share"]) == {"env", "minimal", "minimal_without_labelling"}

@@ -1,7 +1,8 @@
 """Frontier detection, clustering with ``scipy.ndimage.label``, splitting, cluster statistics.
 
 A *frontier cell* is a known-free cell with at least one unknown 4-neighbour. Frontier cells
-are grouped into clusters of contiguous cells (4- or 8-connectivity) by ``scipy.ndimage.label``;
+are grouped into clusters of contiguous cells (4- or 8-connectivity) by ``scipy.ndimage.label``,
+called once for a stack of worlds (:func:`cluster_worlds`; no component crosses worlds);
 a cluster with more than ``max_cells`` cells is split recursively in two across the longer side
 of its bounding box (rows on a tie), at the box's midpoint, until every piece is small enough.
 Clusters are numbered in raster order of their first cell, the convention of
@@ -66,7 +67,8 @@ def frontier_mask(belief: np.ndarray) -> np.ndarray:
 
 
 def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int = 0) -> Clusters:
-    """Find, label and split the frontier clusters of ``belief``.
+    """Find, label and split the frontier clusters of ``belief`` (one world of
+    :func:`cluster_worlds`).
 
     Args:
         belief: int8 belief grid.
@@ -75,13 +77,29 @@ def cluster_frontiers(belief: np.ndarray, connectivity: int = 8, max_cells: int 
     """
     if connectivity not in _STRUCTURES:
         raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
-    mask, rows, cols = frontier_cells(belief)
-    if rows.size == 0:
-        empty = np.zeros(0, dtype=np.int64)
-        return Clusters(belief.shape, empty, empty, empty, empty, np.zeros((0, 2)))
-    image, count = ndimage.label(mask, structure=_STRUCTURES[connectivity])
-    cluster, sizes, centroids = clusters_from_labels(image, rows, cols, count, max_cells)
-    return Clusters(belief.shape, rows, cols, cluster, sizes, centroids)
+    worlds = np.zeros(1, dtype=np.int64)
+    labels, _ = ndimage.label(
+        frontier_masks(belief[None], worlds), structure=stacked_structure(connectivity)
+    )
+    cells = belief.size
+    rows, cols, cluster = (np.zeros((1, cells), dtype=np.int64) for _ in range(3))
+    sizes, centroids = np.zeros((1, cells), dtype=np.int64), np.zeros((1, cells, 2))
+    n_cells, n_clusters = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    cluster_worlds(
+        labels, worlds, max_cells, rows, cols, cluster, n_cells, sizes, centroids, n_clusters
+    )
+    n, k = int(n_cells[0]), int(n_clusters[0])
+    return Clusters(
+        belief.shape, rows[0, :n], cols[0, :n], cluster[0, :n], sizes[0, :k], centroids[0, :k]
+    )
+
+
+def stacked_structure(connectivity: int) -> np.ndarray:
+    """The 3-D structuring element for a stack of worlds: the 2-D neighbourhood within each
+    world, nothing across worlds."""
+    structure = np.zeros((3, 3, 3), dtype=bool)
+    structure[1] = _STRUCTURES[connectivity]
+    return structure
 
 
 def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.ndarray]:
@@ -138,21 +156,6 @@ def frontier_cells(belief: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
                 cols[n] = c
                 n += 1
     return mask, rows[:n], cols[:n]
-
-
-@compiled
-def clusters_from_labels(
-    image: np.ndarray, rows: np.ndarray, cols: np.ndarray, count: int, max_cells: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Cluster index, sizes and centroids of the frontier cells (rows, cols; raster order)
-    labelled 1..count in ``image``, clusters above ``max_cells`` (> 0) split."""
-    label = np.empty(len(rows), dtype=np.int64)
-    for i in range(len(rows)):
-        label[i] = image[rows[i], cols[i]] - 1
-    if max_cells > 0:
-        label, count = split_and_renumber(rows, cols, label, count, max_cells)
-    sizes, centroids = cluster_stats(rows, cols, label, count)
-    return label, sizes, centroids
 
 
 @compiled
@@ -246,3 +249,58 @@ def cluster_stats(
         sums[k, 0] /= sizes[k]
         sums[k, 1] /= sizes[k]
     return sizes, sums
+
+
+@compiled
+def frontier_masks(belief: np.ndarray, worlds: np.ndarray) -> np.ndarray:
+    """(len(worlds), H, W) frontier masks of the given worlds."""
+    out = np.zeros((len(worlds), belief.shape[1], belief.shape[2]), dtype=np.bool_)
+    for m in range(len(worlds)):
+        out[m] = frontier_cells(belief[worlds[m]])[0]
+    return out
+
+
+@compiled
+def cluster_worlds(
+    labels: np.ndarray,
+    worlds: np.ndarray,
+    max_cells: int,
+    cell_rows: np.ndarray,
+    cell_cols: np.ndarray,
+    cell_cluster: np.ndarray,
+    n_cells: np.ndarray,
+    sizes: np.ndarray,
+    centroids: np.ndarray,
+    n_clusters: np.ndarray,
+) -> None:
+    """Clusters of each world from a stacked labelling (labels numbered world after world),
+    split above ``max_cells`` (> 0) and renumbered in raster order, into the world's rows of
+    the cluster buffers."""
+    height, width = labels.shape[1], labels.shape[2]
+    below = 0  # labels used by the worlds before this one
+    for m in range(len(worlds)):
+        n = worlds[m]
+        count = 0
+        top = below
+        for r in range(height):
+            for c in range(width):
+                label = labels[m, r, c]
+                if label > 0:
+                    cell_rows[n, count] = r
+                    cell_cols[n, count] = c
+                    cell_cluster[n, count] = label - 1 - below
+                    top = max(top, label)
+                    count += 1
+        n_cells[n] = count
+        clusters = top - below
+        below = top
+        rows = cell_rows[n, :count]
+        cols = cell_cols[n, :count]
+        cluster = cell_cluster[n, :count]
+        if max_cells > 0 and count > 0:
+            split, clusters = split_and_renumber(rows, cols, cluster.copy(), clusters, max_cells)
+            cluster[:] = split
+        world_sizes, world_centroids = cluster_stats(rows, cols, cluster, clusters)
+        sizes[n, :clusters] = world_sizes
+        centroids[n, :clusters] = world_centroids
+        n_clusters[n] = clusters

@@ -1,0 +1,391 @@
+"""A batch of worlds stepped together: the state of N episodes of K robots in shared arrays.
+
+Every operation of a decision step runs for all worlds in one compiled call (the walk of every
+robot, frontier masks, cluster splitting and statistics, the slots of every robot), and the
+frontier masks of all worlds whose belief changed are labelled by **one**
+``scipy.ndimage.label`` call: the masks are stacked along a first axis that the structuring
+element does not connect, so no component crosses from one world to the next, and labels are
+numbered world by world in raster order, exactly as one call per world would number them.
+:class:`~frontier_marl.core.world.World` is the same thing for one world.
+
+Arrays are indexed ``[world, ...]`` and ``[world, robot, ...]``; read them, never write them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from frontier_marl.core.compiled import compiled
+from frontier_marl.core.frontiers import (
+    Clusters,
+    cluster_worlds,
+    frontier_masks,
+    stacked_structure,
+    unknown_around,
+)
+from frontier_marl.core.grid import FREE, UNKNOWN
+from frontier_marl.core.maps import FOUR_CONNECTED
+from frontier_marl.core.movement import walk
+from frontier_marl.core.sensing import Sensor, reveal
+from frontier_marl.core.slots import _robot_slots
+
+FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
+
+
+@dataclass(frozen=True)
+class WorldParams:
+    """Static parameters of the world transition."""
+
+    sensor: Sensor
+    cells_per_step: int  # >= 1, or FULL_PATH
+    connectivity: int = 8
+    max_cluster_cells: int = 0
+    gain: str = "size"  # or "unknown"
+
+
+@dataclass(slots=True)
+class SlotArrays:
+    """The slots of every robot, fields of :class:`~frontier_marl.core.slots.SlotTable` with
+    leading ``(N, K)`` axes; fresh arrays each time they are computed."""
+
+    cluster: np.ndarray  # int (N, K, S)
+    valid: np.ndarray  # bool (N, K, S)
+    centroid: np.ndarray  # float (N, K, S, 2)
+    target: np.ndarray  # int (N, K, S, 2)
+    distance: np.ndarray  # float (N, K, S)
+    size: np.ndarray  # int (N, K, S)
+    gain: np.ndarray  # float (N, K, S)
+    path_length: np.ndarray  # int (N, K, S)
+    mask: np.ndarray  # int8 (N, K, S)
+    live: np.ndarray  # int (N, K)
+
+
+class Worlds:
+    """N worlds of K robots each; worlds are placed (reset) one by one and stepped together."""
+
+    def __init__(
+        self, shape: tuple[int, int], n_worlds: int, n_agents: int, params: WorldParams
+    ) -> None:
+        height, width = shape
+        n, k = n_worlds, n_agents
+        cells = height * width
+        self.params = params
+        self.shape = (height, width)
+        self.n_worlds, self.n_agents = n, k
+        self.true = np.zeros((n, height, width), dtype=bool)
+        self.belief = np.full((n, height, width), UNKNOWN, dtype=np.int8)
+        self.positions = np.zeros((n, k, 2), dtype=np.int64)
+        self.seen = np.zeros((n, k, height, width), dtype=bool)
+        self.travelled = np.zeros((n, k), dtype=np.int64)
+        self.start_region = np.zeros((n, height, width), dtype=bool)
+        self.start_region_size = np.zeros(n, dtype=np.int64)
+        self.true_free = np.zeros(n, dtype=np.int64)
+        self.version = np.zeros(n, dtype=np.int64)  # bumped whenever a belief changes
+        # The walk: plan cache and outputs (see movement.walk).
+        budget = params.cells_per_step
+        walk_cells = cells if budget == FULL_PATH else min(budget + 1, cells)
+        self.plan_cells = np.zeros((n, k, cells, 2), dtype=np.int64)
+        self.plan_meta = np.full((n, k, 5), -1, dtype=np.int64)
+        self.goals = np.full((n, k, 2), -1, dtype=np.int64)
+        self.new_cells = np.zeros((n, k), dtype=np.int64)
+        self.walked = np.zeros((n, k, walk_cells, 2), dtype=np.int64)
+        self.walked_len = np.zeros((n, k), dtype=np.int64)
+        self.reached = np.zeros((n, k), dtype=bool)
+        # Frontier clusters per world, cells and clusters in raster order (capacity: all cells).
+        self.cell_rows = np.zeros((n, cells), dtype=np.int64)
+        self.cell_cols = np.zeros((n, cells), dtype=np.int64)
+        self.cell_cluster = np.zeros((n, cells), dtype=np.int64)
+        self.n_cells = np.zeros(n, dtype=np.int64)
+        self.sizes = np.zeros((n, cells), dtype=np.int64)
+        self.centroids = np.zeros((n, cells, 2))
+        self.gains = np.zeros((n, cells))
+        self.n_clusters = np.zeros(n, dtype=np.int64)
+        self.clustered_version = np.full(n, -1, dtype=np.int64)
+        self._structure = stacked_structure(params.connectivity)
+
+    # ----------------------------------------------------------------- episodes
+    def place(
+        self,
+        world: int,
+        true_grid: np.ndarray,
+        starts: np.ndarray,
+        start_region: np.ndarray | None = None,
+    ) -> None:
+        """Start world ``world`` on ``true_grid`` with robots at ``starts`` (K, 2), sensing at
+        their cells. ``start_region``: the free cells reachable from the starts, if known."""
+        starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+        true_grid = np.asarray(true_grid, dtype=bool)
+        if true_grid.shape != self.shape:
+            raise ValueError(f"true grid of shape {true_grid.shape}, expected {self.shape}")
+        if len(starts) != self.n_agents:
+            raise ValueError(f"expected {self.n_agents} start cells, got {len(starts)}")
+        if true_grid[starts[:, 0], starts[:, 1]].any():
+            raise ValueError("every start cell must be free")
+        if len({tuple(s) for s in starts.tolist()}) != len(starts):
+            raise ValueError("start cells must be distinct")
+        if start_region is None:
+            start_region = reachable_region(true_grid, starts)
+        elif not start_region[starts[:, 0], starts[:, 1]].all():
+            raise ValueError("start_region must contain every start cell")
+        i = world
+        self.true[i] = true_grid
+        self.belief[i] = UNKNOWN
+        self.positions[i] = starts
+        self.seen[i] = False
+        self.travelled[i] = 0
+        self.plan_meta[i] = -1
+        self.goals[i] = -1
+        self.start_region[i] = start_region
+        self.start_region_size[i] = np.count_nonzero(start_region)
+        self.true_free[i] = np.count_nonzero(~true_grid)
+        self.version[i] += 1
+        offsets, between = self.params.sensor.rays
+        for agent in range(self.n_agents):
+            row, col = int(starts[agent, 0]), int(starts[agent, 1])
+            if reveal(
+                self.true[i], self.belief[i], self.seen[i, agent], row, col, offsets, between
+            ):
+                self.version[i] += 1
+
+    # ----------------------------------------------------------------- transition
+    def move(self, goals: np.ndarray, active: np.ndarray) -> None:
+        """Walk every robot of the ``active`` worlds toward ``goals`` (N, K, 2; row -1: stay);
+        the outputs are left in ``new_cells``, ``walked``, ``walked_len`` and ``reached``."""
+        self.goals[:] = goals
+        offsets, between = self.params.sensor.rays
+        walk_worlds(
+            active,
+            self.true,
+            self.belief,
+            self.seen,
+            self.positions,
+            self.travelled,
+            self.goals,
+            self.plan_cells,
+            self.plan_meta,
+            self.version,
+            self.params.cells_per_step,
+            offsets,
+            between,
+            self.new_cells,
+            self.walked,
+            self.walked_len,
+            self.reached,
+        )
+
+    # ----------------------------------------------------------------- frontier view
+    def refresh_clusters(self) -> None:
+        """Recluster the worlds whose belief changed since they were last clustered."""
+        stale = np.flatnonzero(self.clustered_version != self.version)
+        if len(stale) == 0:
+            return
+        masks = frontier_masks(self.belief, stale)
+        labels, _ = ndimage.label(masks, structure=self._structure)
+        cluster_worlds(
+            labels,
+            stale,
+            self.params.max_cluster_cells,
+            self.cell_rows,
+            self.cell_cols,
+            self.cell_cluster,
+            self.n_cells,
+            self.sizes,
+            self.centroids,
+            self.n_clusters,
+        )
+        if self.params.gain == "unknown":
+            for world in stale.tolist():
+                count = int(self.n_clusters[world])
+                self.gains[world, :count] = unknown_around(self.belief[world], self.clusters(world))
+        else:
+            self.gains[stale] = self.sizes[stale]
+        self.clustered_version[stale] = self.version[stale]
+
+    def clusters(self, world: int) -> Clusters:
+        """World ``world``'s clusters as of its last :meth:`refresh_clusters`."""
+        cells, count = int(self.n_cells[world]), int(self.n_clusters[world])
+        return Clusters(
+            self.shape,
+            self.cell_rows[world, :cells],
+            self.cell_cols[world, :cells],
+            self.cell_cluster[world, :cells],
+            self.sizes[world, :count],
+            self.centroids[world, :count],
+        )
+
+    def slots(self, n_slots: int, sort_by_distance: bool) -> SlotArrays:
+        """The slots of every robot of every world (clusters refreshed first)."""
+        self.refresh_clusters()
+        n, k = self.n_worlds, self.n_agents
+        out = SlotArrays(
+            cluster=np.empty((n, k, n_slots), dtype=np.int64),
+            valid=np.empty((n, k, n_slots), dtype=bool),
+            centroid=np.empty((n, k, n_slots, 2)),
+            target=np.empty((n, k, n_slots, 2), dtype=np.int64),
+            distance=np.empty((n, k, n_slots)),
+            size=np.empty((n, k, n_slots), dtype=np.int64),
+            gain=np.empty((n, k, n_slots)),
+            path_length=np.empty((n, k, n_slots), dtype=np.int64),
+            mask=np.empty((n, k, n_slots), dtype=np.int8),
+            live=np.empty((n, k), dtype=np.int64),
+        )
+        all_slots(
+            self.belief,
+            self.positions,
+            self.cell_rows,
+            self.cell_cols,
+            self.cell_cluster,
+            self.n_cells,
+            self.centroids,
+            self.sizes,
+            self.gains,
+            self.n_clusters,
+            n_slots,
+            sort_by_distance,
+            out.cluster,
+            out.valid,
+            out.centroid,
+            out.target,
+            out.distance,
+            out.size,
+            out.gain,
+            out.path_length,
+            out.mask,
+            out.live,
+        )
+        return out
+
+    def explored_fraction(self, basis: str) -> np.ndarray:
+        """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
+        of the ``reachable`` free region known."""
+        belief = self.belief
+        if basis == "all":
+            return np.count_nonzero(belief != UNKNOWN, axis=(1, 2)) / belief[0].size
+        if basis == "free":
+            return np.count_nonzero(belief == FREE, axis=(1, 2)) / np.maximum(self.true_free, 1)
+        if basis == "reachable":
+            known = count_known(belief, self.start_region)
+            return known / np.maximum(self.start_region_size, 1)
+        raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
+
+
+def reachable_region(true_grid: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """The free cells 4-connected to any of the ``starts`` on ``true_grid``."""
+    labels, _ = ndimage.label(~true_grid, structure=FOUR_CONNECTED)
+    ids = np.unique(labels[starts[:, 0], starts[:, 1]])
+    return np.isin(labels, ids)
+
+
+@compiled
+def walk_worlds(
+    active: np.ndarray,
+    true: np.ndarray,
+    belief: np.ndarray,
+    seen: np.ndarray,
+    positions: np.ndarray,
+    travelled: np.ndarray,
+    goals: np.ndarray,
+    plan_cells: np.ndarray,
+    plan_meta: np.ndarray,
+    version: np.ndarray,
+    cells_per_step: int,
+    offsets: np.ndarray,
+    between: np.ndarray,
+    new_cells: np.ndarray,
+    walked: np.ndarray,
+    walked_len: np.ndarray,
+    reached: np.ndarray,
+) -> None:
+    """:func:`~frontier_marl.core.movement.walk` for every active world."""
+    for n in range(len(active)):
+        if not active[n]:
+            continue
+        version[n] = walk(
+            true[n],
+            belief[n],
+            seen[n],
+            positions[n],
+            travelled[n],
+            goals[n],
+            plan_cells[n],
+            plan_meta[n],
+            version[n],
+            cells_per_step,
+            offsets,
+            between,
+            new_cells[n],
+            walked[n],
+            walked_len[n],
+            reached[n],
+        )
+
+
+@compiled
+def all_slots(
+    belief: np.ndarray,
+    positions: np.ndarray,
+    cell_rows: np.ndarray,
+    cell_cols: np.ndarray,
+    cell_cluster: np.ndarray,
+    n_cells: np.ndarray,
+    centroids: np.ndarray,
+    sizes: np.ndarray,
+    gains: np.ndarray,
+    n_clusters: np.ndarray,
+    n_slots: int,
+    sort: bool,
+    cluster: np.ndarray,
+    valid: np.ndarray,
+    centroid: np.ndarray,
+    target: np.ndarray,
+    distance: np.ndarray,
+    size: np.ndarray,
+    gain: np.ndarray,
+    path_length: np.ndarray,
+    mask: np.ndarray,
+    live: np.ndarray,
+) -> None:
+    """:func:`~frontier_marl.core.slots._robot_slots` of every robot, into the outputs."""
+    for n in range(positions.shape[0]):
+        cells, count = n_cells[n], n_clusters[n]
+        for k in range(positions.shape[1]):
+            result = _robot_slots(
+                belief[n],
+                positions[n, k, 0],
+                positions[n, k, 1],
+                cell_rows[n, :cells],
+                cell_cols[n, :cells],
+                cell_cluster[n, :cells],
+                centroids[n, :count],
+                sizes[n, :count],
+                gains[n, :count],
+                n_slots,
+                sort,
+            )
+            cluster[n, k] = result[0]
+            valid[n, k] = result[1]
+            centroid[n, k] = result[2]
+            target[n, k] = result[3]
+            distance[n, k] = result[4]
+            size[n, k] = result[5]
+            gain[n, k] = result[6]
+            path_length[n, k] = result[7]
+            mask[n, k] = result[8]
+            live[n, k] = result[9]
+
+
+@compiled
+def count_known(belief: np.ndarray, region: np.ndarray) -> np.ndarray:
+    """Per world, the known cells of ``belief`` inside the bool mask ``region``."""
+    out = np.zeros(belief.shape[0], dtype=np.int64)
+    for n in range(belief.shape[0]):
+        count = 0
+        for r in range(belief.shape[1]):
+            for c in range(belief.shape[2]):
+                if region[n, r, c] and belief[n, r, c] != UNKNOWN:
+                    count += 1
+        out[n] = count
+    return out
