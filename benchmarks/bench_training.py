@@ -5,7 +5,8 @@
     python benchmarks/bench_training.py --stages   # also time the stages inside the env step
 
 Runs the real training loop (``frontier_marl.training.train.train``, no evaluation, no
-checkpoints) and times, inside it, the env (the FrontierParallelEnv step itself), the SuperSuit
+checkpoints, the SuperSuit pipeline: ``train.vec_env=supersuit``; the batched env has its own
+benchmark, ``bench_vector_env.py``) and times, inside it, the env (the FrontierParallelEnv step itself), the SuperSuit
 and SB3 vector layers above it, and the DQN gradient steps; the rest is SB3's collection loop
 (action selection, replay buffer, logging). ``--stages`` also times the parts of a decision
 step (movement and sensing, frontier clustering and ``scipy.ndimage.label``, slots,
@@ -92,6 +93,7 @@ def main(argv: list[str] | None = None) -> int:
             f"train.seed={args.seed}",
             "train.eval_episodes=0",
             "train.checkpoint_every=0",
+            "train.vec_env=supersuit",  # the layers timed below are SuperSuit's
         ],
     )
     env_timer, vec_timer, grad_timer = Timer(), Timer(), Timer()

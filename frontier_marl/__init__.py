@@ -7,6 +7,7 @@ Entry points::
     aec = frontier_marl.env(preset="thesis-20x20")                        # PettingZoo AEC
     import gymnasium as gym
     single = gym.make("frontier_marl/FrontierExplore-v0", preset="thesis-20x20")
+    batch = frontier_marl.vector_env(num_envs=64, preset="thesis-20x20")  # Gymnasium VectorEnv
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Any
 
 from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
 from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
+from frontier_marl.envs.vector import FrontierVectorEnv, vector_env
 from frontier_marl.registration import GYM_ID, PETTINGZOO_ID, register_envs
 
 __version__ = "0.1.0"
@@ -45,10 +47,12 @@ __all__ = [
     "EnvConfig",
     "FrontierExploreEnv",
     "FrontierParallelEnv",
+    "FrontierVectorEnv",
     "ObservationConfig",
     "RewardConfig",
     "env",
     "make_config",
     "parallel_env",
     "raw_env",
+    "vector_env",
 ]

@@ -17,18 +17,11 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.map_files import load_map
-from frontier_marl.core.maps import (
-    largest_free_component,
-    random_obstacle_map,
-    rooms_map,
-    sample_start_cells,
-)
-from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.slots import SlotTable
-from frontier_marl.core.world import FULL_PATH, MoveResult, World, WorldParams
-from frontier_marl.observations import ObservationEncoder
-from frontier_marl.rewards import OscillationDetector, StepEvents, StepOutcome, step_outcome
+from frontier_marl.core.world import MoveResult, World
+from frontier_marl.episodes import EpisodeSource, world_params
+from frontier_marl.observations import ObservationEncoder, teammate_rows
+from frontier_marl.rewards import OscillationHistory, StepEvents, StepOutcome, step_outcome
 
 Observation = np.ndarray | dict[str, np.ndarray]
 
@@ -68,68 +61,22 @@ class ExplorationMDP:
     def __init__(self, cfg: EnvConfig) -> None:
         self.cfg = cfg
         self.encoder = ObservationEncoder(cfg)
-        self.params = WorldParams(
-            sensor=make_sensor(cfg.sensor, cfg.perception_range),
-            cells_per_step=FULL_PATH if cfg.walks_full_path else int(cfg.cells_per_step),
-            connectivity=cfg.connectivity,
-            max_cluster_cells=cfg.max_cluster_cells,
-            gain=cfg.gain,
-        )
-        self._static_map: np.ndarray | None = None
-        self._region_grid: np.ndarray | None = None  # the grid _start_region belongs to
-        self._start_region = np.zeros((0, 0), dtype=bool)
+        self.params = world_params(cfg)
+        self.source = EpisodeSource(cfg)
         self.world: World | None = None
         self._slots: list[SlotTable] = []
-        self._oscillation: list[OscillationDetector] = []
+        self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
         self.steps_without_progress = 0
         self.done = True
 
     # ------------------------------------------------------------------ episode
-    def true_grid_for_episode(self, rng: np.random.Generator) -> np.ndarray:
-        """The layout from ``map_path``, the static one (from ``map_seed``), or a fresh dynamic
-        one (from ``rng``)."""
-        cfg = self.cfg
-        if cfg.map_path is not None:
-            if self._static_map is None:
-                self._static_map = load_map(cfg.map_path)
-            return self._static_map
-        if cfg.map_mode == "static":
-            if self._static_map is None:
-                self._static_map = self._generate(np.random.default_rng(cfg.map_seed))
-            return self._static_map
-        return self._generate(rng)
-
-    def _generate(self, rng: np.random.Generator) -> np.ndarray:
-        cfg = self.cfg
-        if cfg.map_generator == "rooms":
-            return rooms_map(cfg.height, cfg.width, rng)
-        density = cfg.obstacle_prob
-        if cfg.obstacle_prob_spread > 0 and cfg.map_mode == "dynamic":
-            low = max(0.0, density - cfg.obstacle_prob_spread)
-            density = float(rng.uniform(low, min(0.9, density + cfg.obstacle_prob_spread)))
-        return random_obstacle_map(cfg.height, cfg.width, density, rng)
-
     def reset(self, rng: np.random.Generator) -> list[Observation]:
         """Start an episode: map, start cells (``start_cells``), first sensing."""
-        cfg = self.cfg
-        true_grid = self.true_grid_for_episode(rng)
-        if true_grid is not self._region_grid:  # a static map keeps its start region
-            self._region_grid = true_grid
-            if cfg.start_cells == "any-free":
-                self._start_region = ~true_grid
-            else:
-                self._start_region = largest_free_component(true_grid)
-            self._start_region.setflags(write=False)
-        starts = sample_start_cells(self._start_region, cfg.n_agents, rng)
-        if cfg.start_cells == "any-free":  # the world finds the region reachable from them
-            self.world = World(true_grid, starts, self.params)
-        else:  # starts in one 4-connected component: it is the region reachable from them
-            self.world = World(true_grid, starts, self.params, self._start_region)
-        self._oscillation = [
-            OscillationDetector(cfg.reward.oscillation_window) for _ in range(cfg.n_agents)
-        ]
+        true_grid, starts, start_region = self.source.draw(rng)
+        self.world = World(true_grid, starts, self.params, start_region)
+        self._oscillation.clear(slice(None))
         self.steps = 0
         self.steps_without_progress = 0
         self.done = False
@@ -146,20 +93,16 @@ class ExplorationMDP:
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
         slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
-        goals: list[tuple[int, int] | None] = []
-        padding: list[bool] = []
-        oscillation: list[bool] = []
-        for slot, table, detector in zip(slots, self._slots, self._oscillation, strict=True):
+        targets = np.full((n, 2), -1, dtype=np.int64)
+        padding = np.zeros(n, dtype=bool)
+        for agent, (slot, table) in enumerate(zip(slots, self._slots, strict=True)):
             if slot < table.live:  # live slots come first
-                row, col = table.target[slot].tolist()
-                goals.append((row, col))
-                padding.append(False)
+                targets[agent] = table.target[slot]
             else:
-                goals.append(None)
-                padding.append(table.live > 0)
-            oscillation.append(detector.update(goals[-1]))
+                padding[agent] = table.live > 0
+        oscillation = self._oscillation.update(targets[None])[0]
         world = self.world
-        moved = world.move(goals)
+        moved = world.move(targets)
         self.steps += 1
         new_cells = moved.new_cells.tolist()
         self.steps_without_progress = 0 if any(new_cells) else self.steps_without_progress + 1
@@ -176,12 +119,11 @@ class ExplorationMDP:
         )
         outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
-        targets = np.array([(-1, -1) if goal is None else goal for goal in goals], dtype=np.int64)
         self.last = StepResult(
             self._observations(targets, moved.reached),
             targets,
-            np.array(padding),
-            np.array(oscillation),
+            padding,
+            oscillation,
             moved,
             outcome,
         )
@@ -234,14 +176,21 @@ class ExplorationMDP:
         assert self.world is not None
         positions = self.world.positions
         mates = self._teammate_table(positions, targets, reached)
-        return [
-            self.encoder.encode(
-                table,
-                positions[agent],
-                None if mates is None else np.delete(mates, agent, axis=0),
-            )
-            for agent, table in enumerate(self._slots)
-        ]
+        tables = self._slots
+        batch = self.encoder.encode_batch(
+            np.stack([table.centroid for table in tables]),
+            np.stack([table.valid for table in tables]),
+            np.stack([table.distance for table in tables]),
+            np.stack([table.gain for table in tables]),
+            np.stack([table.mask for table in tables]),
+            positions,
+            None if mates is None else teammate_rows(mates),
+        )
+        if isinstance(batch, dict):
+            return [
+                {key: value[agent] for key, value in batch.items()} for agent in range(len(tables))
+            ]
+        return list(batch)
 
     def _teammate_table(
         self, positions: np.ndarray, targets: np.ndarray | None, reached: np.ndarray | None

@@ -100,41 +100,77 @@ class ObservationEncoder:
         ``teammates`` is (N-1, 2) or (N-1, 4): the other robots' (row, col) positions, and
         targets for ``positions+targets``; needed only when the layout includes teammates.
         """
+        batch = self.encode_batch(
+            slots.centroid[None],
+            slots.valid[None],
+            slots.distance[None],
+            slots.gain[None],
+            slots.mask[None],
+            np.asarray(position)[None],
+            None if teammates is None else np.asarray(teammates).reshape(1, -1),
+        )
+        if isinstance(batch, dict):
+            return {key: value[0] for key, value in batch.items()}
+        return batch[0]
+
+    def encode_batch(
+        self,
+        centroid: np.ndarray,
+        valid: np.ndarray,
+        distance: np.ndarray,
+        gain: np.ndarray,
+        mask: np.ndarray,
+        positions: np.ndarray,
+        teammates: np.ndarray | None = None,
+    ) -> np.ndarray | dict[str, np.ndarray]:
+        """The observations of M robots at once: slot fields ``(M, n_slots, ...)`` as in
+        :class:`SlotTable`, ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened
+        per robot. Returns the ``(M, ...)`` array, or a dict of them, of :attr:`space`'s layout.
+        """
         dtype = np.float64 if self.normalize else np.float32  # normalize in float64
-        features = np.zeros((self.n_slots, self.features_per_slot), dtype=dtype)
-        k = slots.live
+        count = len(positions)
+        features = np.zeros((count, self.n_slots, self.features_per_slot), dtype=dtype)
         column = 0
         if self.centroid == "absolute":
-            features[:k, 0:2] = slots.centroid[:k]
+            features[..., 0:2] = centroid  # padding slots hold zeros
             column = 2
         elif self.centroid == "relative":
-            features[:k, 0:2] = slots.centroid[:k] - position
+            features[..., 0:2] = np.where(valid[..., None], centroid - positions[:, None, :], 0.0)
             column = 2
         elif self.centroid == "distance":
-            features[:k, 0] = slots.distance[:k]
+            features[..., 0] = distance
             column = 1
         if self.info_gain:
-            features[:k, column] = slots.gain[:k]
+            features[..., column] = gain
         if self.normalize:
             features = (features / self._scale).astype(np.float32)
-        flat = features.ravel()
+        flat = features.reshape(count, -1)
         if not self.is_dict:
             return flat
         out: dict[str, np.ndarray] = {"clusters": flat}
         if self.agent_position:
             out["agent_position"] = (
-                (position / self._position_scale).astype(np.float32)
+                (positions / self._position_scale).astype(np.float32)
                 if self.normalize
-                else position.astype(np.float32)
+                else positions.astype(np.float32)
             )
         if self.action_mask:
-            out["action_mask"] = slots.action_mask()
+            out["action_mask"] = np.array(mask, dtype=np.int8)
         if self.teammates != "none":
             if teammates is None:
                 raise ValueError("this observation layout needs the teammates' positions")
             scale = np.tile(self._position_scale, teammates.shape[1] // 2)
-            out["teammates"] = (teammates / scale).astype(np.float32).ravel()
+            out["teammates"] = (teammates / scale).astype(np.float32)
         return out
+
+
+def teammate_rows(table: np.ndarray) -> np.ndarray:
+    """Per robot, the rows of its teammates: ``(..., N, F)`` -> ``(..., N, (N-1) x F)``, the
+    other robots' rows in agent order, flattened."""
+    n = table.shape[-2]
+    others = np.array([[j for j in range(n) if j != i] for i in range(n)], dtype=np.int64)
+    picked = table[..., others.reshape(-1), :]  # (..., N * (N-1), F)
+    return picked.reshape(*table.shape[:-2], n, (n - 1) * table.shape[-1])
 
 
 def describe_layout(cfg: EnvConfig) -> dict[str, Any]:

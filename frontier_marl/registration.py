@@ -3,6 +3,8 @@
 behaviour changes.
 
     gymnasium.make("frontier_marl/FrontierExplore-Thesis30x30-v0")
+    gymnasium.make_vec("frontier_marl/FrontierExplore-v0", num_envs=64,
+                       vectorization_mode="vector_entry_point")   # the batched vector env
     pettingzoo.make("parallel", "frontier_marl/FrontierExplore-Rooms32-v0", n_agents=4)
 """
 
@@ -37,6 +39,7 @@ def register_envs() -> None:
             gymnasium.register(
                 id=env_id,
                 entry_point="frontier_marl.envs.gym_env:FrontierExploreEnv",
+                vector_entry_point="frontier_marl.envs.vector:FrontierVectorEnv",
                 kwargs=dict(kwargs),
                 disable_env_checker=False,
             )

@@ -62,6 +62,22 @@ class SlotArrays:
     mask: np.ndarray  # int8 (N, K, S)
     live: np.ndarray  # int (N, K)
 
+    @classmethod
+    def empty(cls, n_worlds: int, n_agents: int, n_slots: int) -> SlotArrays:
+        shape = (n_worlds, n_agents, n_slots)
+        return cls(
+            cluster=np.full(shape, -1, dtype=np.int64),
+            valid=np.zeros(shape, dtype=bool),
+            centroid=np.zeros((*shape, 2)),
+            target=np.full((*shape, 2), -1, dtype=np.int64),
+            distance=np.zeros(shape),
+            size=np.zeros(shape, dtype=np.int64),
+            gain=np.zeros(shape),
+            path_length=np.full(shape, -1, dtype=np.int64),
+            mask=np.zeros(shape, dtype=np.int8),
+            live=np.zeros(shape[:2], dtype=np.int64),
+        )
+
 
 class Worlds:
     """N worlds of K robots each; worlds are placed (reset) one by one and stepped together."""
@@ -216,23 +232,12 @@ class Worlds:
             self.centroids[world, :count],
         )
 
-    def slots(self, n_slots: int, sort_by_distance: bool) -> SlotArrays:
-        """The slots of every robot of every world (clusters refreshed first)."""
+    def slots(self, out: SlotArrays, worlds: np.ndarray, sort_by_distance: bool) -> None:
+        """The slots of every robot of ``worlds`` (indices) into ``out`` (clusters refreshed
+        first); ``out``'s last axis is the number of slots."""
         self.refresh_clusters()
-        n, k = self.n_worlds, self.n_agents
-        out = SlotArrays(
-            cluster=np.empty((n, k, n_slots), dtype=np.int64),
-            valid=np.empty((n, k, n_slots), dtype=bool),
-            centroid=np.empty((n, k, n_slots, 2)),
-            target=np.empty((n, k, n_slots, 2), dtype=np.int64),
-            distance=np.empty((n, k, n_slots)),
-            size=np.empty((n, k, n_slots), dtype=np.int64),
-            gain=np.empty((n, k, n_slots)),
-            path_length=np.empty((n, k, n_slots), dtype=np.int64),
-            mask=np.empty((n, k, n_slots), dtype=np.int8),
-            live=np.empty((n, k), dtype=np.int64),
-        )
         all_slots(
+            worlds,
             self.belief,
             self.positions,
             self.cell_rows,
@@ -243,7 +248,7 @@ class Worlds:
             self.sizes,
             self.gains,
             self.n_clusters,
-            n_slots,
+            out.cluster.shape[-1],
             sort_by_distance,
             out.cluster,
             out.valid,
@@ -256,7 +261,6 @@ class Worlds:
             out.mask,
             out.live,
         )
-        return out
 
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
@@ -325,6 +329,7 @@ def walk_worlds(
 
 @compiled
 def all_slots(
+    worlds: np.ndarray,
     belief: np.ndarray,
     positions: np.ndarray,
     cell_rows: np.ndarray,
@@ -348,8 +353,9 @@ def all_slots(
     mask: np.ndarray,
     live: np.ndarray,
 ) -> None:
-    """:func:`~frontier_marl.core.slots._robot_slots` of every robot, into the outputs."""
-    for n in range(positions.shape[0]):
+    """:func:`~frontier_marl.core.slots._robot_slots` of every robot of ``worlds``, into the
+    outputs."""
+    for n in worlds:
         cells, count = n_cells[n], n_clusters[n]
         for k in range(positions.shape[1]):
             result = _robot_slots(

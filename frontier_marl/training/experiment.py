@@ -54,6 +54,7 @@ _RESERVED_DQN = {
 
 
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
+VEC_ENVS = ("batched", "supersuit")
 
 
 @dataclass(frozen=True)
@@ -63,7 +64,10 @@ class TrainSettings:
     Attributes:
         total_timesteps: environment steps (transitions) to train for.
         seed: seeds torch/numpy/random, the action space, and every vector copy (distinctly).
-        n_envs: concatenated copies of the env (1 keeps ``train_freq`` in the thesis's units).
+        n_envs: worlds stepped side by side (1 keeps ``train_freq`` in the thesis's units).
+        vec_env: how they are stepped: ``batched`` (the default; all worlds in one call,
+            :mod:`frontier_marl.envs.vector`) or ``supersuit`` (SuperSuit's concatenated
+            copies of the ParallelEnv). Both give the same transitions.
         checkpoint_every: steps between checkpoints (model + replay buffer + metadata);
             0 disables periodic checkpoints (the final model and Ctrl-C still save).
         keep_checkpoints: newest checkpoints kept on disk (0 keeps all).
@@ -90,6 +94,7 @@ class TrainSettings:
     total_timesteps: int = 1_000_000
     seed: int = 0
     n_envs: int = 1
+    vec_env: str = "batched"
     checkpoint_every: int = 100_000
     keep_checkpoints: int = 2
     log_interval: int = 10
@@ -121,6 +126,8 @@ class TrainSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if self.vec_env not in VEC_ENVS:
+            raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
         if not isinstance(self.bootstrap_truncations, bool):
             raise ValueError(
                 "train.bootstrap_truncations must be true or false, "

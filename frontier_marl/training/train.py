@@ -136,6 +136,7 @@ def train(
     from stable_baselines3 import DQN
     from stable_baselines3.common.utils import set_random_seed
 
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
     from frontier_marl.training.vec_env import make_vec_env
 
     settings: TrainSettings = experiment.train
@@ -156,7 +157,8 @@ def train(
     start_step = 0 if checkpoint is None else checkpoint.step
     seed = session_seed(settings.seed, start_step)
     set_random_seed(seed)
-    vec_env = make_vec_env(
+    make = make_batched_vec_env if settings.vec_env == "batched" else make_vec_env
+    vec_env = make(
         {"config": cfg},
         settings.n_envs,
         seed=seed,

@@ -1,0 +1,153 @@
+"""The decision process of N worlds stepped together, for the batched vector env.
+
+:class:`BatchMDP` holds N episodes of ``cfg.n_agents`` robots in shared arrays
+(:class:`~frontier_marl.core.worlds.Worlds`) and applies the rules of
+:class:`~frontier_marl.engine.ExplorationMDP` to all of them at once: actions become targets,
+one compiled call walks every robot, the frontier masks of all worlds whose belief changed are
+labelled by one ``scipy.ndimage.label`` call, one compiled call builds every robot's slots, and
+the reward table, the oscillation test and the observation encoder run on whole arrays. World
+``i`` draws its episodes from its own ``numpy.random.Generator``, so with the same generator
+it plays exactly the episodes of the single-world engine.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.worlds import SlotArrays, Worlds
+from frontier_marl.episodes import EpisodeSource, world_params
+from frontier_marl.observations import ObservationEncoder, teammate_rows
+from frontier_marl.rewards import BatchOutcome, OscillationHistory, batch_outcome
+
+Observations = np.ndarray | dict[str, np.ndarray]
+
+
+class BatchMDP:
+    """Frontier-selection MDP of ``n_worlds`` worlds with ``cfg.n_agents`` robots each.
+
+    After :meth:`step` the step's results are in arrays indexed ``[world, robot]``:
+    ``targets``, ``padding``, ``oscillation``, ``new_cells`` and ``outcome`` (rewards, flags,
+    end-reason codes). Worlds whose episode ended stay ``done`` until :meth:`reset_worlds`.
+    """
+
+    def __init__(self, cfg: EnvConfig, n_worlds: int) -> None:
+        if isinstance(n_worlds, bool) or not isinstance(n_worlds, int | np.integer):
+            raise TypeError(f"num_envs must be an integer >= 1, got {n_worlds!r}")
+        if n_worlds < 1:
+            raise ValueError(f"num_envs must be an integer >= 1, got {n_worlds}")
+        n, k = int(n_worlds), cfg.n_agents
+        self.cfg = cfg
+        self.n_worlds, self.n_agents, self.n_slots = n, k, cfg.n_slots
+        self.encoder = ObservationEncoder(cfg)
+        self.worlds = Worlds(cfg.shape, n, k, world_params(cfg))
+        self.source = EpisodeSource(cfg)
+        self.rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(n)]
+        self.slots = SlotArrays.empty(n, k, cfg.n_slots)
+        self._oscillation = OscillationHistory(n, k, cfg.reward.oscillation_window)
+        self.steps = np.zeros(n, dtype=np.int64)
+        self.steps_without_progress = np.zeros(n, dtype=np.int64)
+        self.done = np.ones(n, dtype=bool)
+        self.targets = np.full((n, k, 2), -1, dtype=np.int64)
+        self.heading = np.zeros((n, k, 2), dtype=np.int64)  # current targets, 0 when none
+        self.padding = np.zeros((n, k), dtype=bool)
+        self.oscillation = np.zeros((n, k), dtype=bool)
+        self.new_cells = np.zeros((n, k), dtype=np.int64)
+        self.outcome = BatchOutcome(
+            np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
+        )
+        self._all = np.arange(n)
+
+    # ------------------------------------------------------------------ episodes
+    def reset_worlds(self, worlds: np.ndarray) -> None:
+        """Start a new episode in each world of ``worlds`` (indices), from its own generator."""
+        for i in worlds.tolist():
+            true_grid, starts, start_region = self.source.draw(self.rngs[i])
+            self.worlds.place(i, true_grid, starts, start_region)
+        self._oscillation.clear(worlds)
+        self.steps[worlds] = 0
+        self.steps_without_progress[worlds] = 0
+        self.done[worlds] = False
+        self.targets[worlds] = -1
+        self.heading[worlds] = 0
+        self.padding[worlds] = False
+        self.oscillation[worlds] = False
+        self.new_cells[worlds] = 0
+        self.worlds.slots(self.slots, worlds, self.cfg.observation.sort_by_distance)
+
+    # ------------------------------------------------------------------ transition
+    def step(self, actions: np.ndarray, active: np.ndarray) -> None:
+        """One decision per robot of the ``active`` worlds (bool (N,)): ``actions`` (N, K)
+        holds valid slot indices (checked by the caller). Inactive worlds do not change."""
+        slots = self.slots
+        live = slots.live
+        chosen = actions < live  # live slots come first
+        picked = np.take_along_axis(slots.target, actions[:, :, None, None], axis=2)[:, :, 0]
+        targets = np.where(chosen[..., None], picked, -1)
+        targets[~active] = -1
+        padding = ~chosen & (live > 0) & active[:, None]
+        oscillation = self._oscillation.update(targets)
+        worlds = self.worlds
+        worlds.move(targets, active)
+        new_cells = np.where(active[:, None], worlds.new_cells, 0)
+        self.steps += active
+        progress = new_cells.any(axis=1)
+        self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + 1)
+        indices = self._all[active]
+        worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
+        reward = self.cfg.reward
+        fraction = worlds.explored_fraction(reward.threshold_basis)
+        outcome = batch_outcome(
+            reward,
+            new_cells,
+            padding,
+            oscillation,
+            fraction >= reward.explore_threshold,
+            (slots.live == 0).all(axis=1),
+            self.steps,
+            self.steps_without_progress,
+        )
+        # inactive worlds keep their state: no reward, no new end
+        outcome.rewards[~active] = 0.0
+        outcome.terminated &= active
+        outcome.truncated &= active
+        outcome.reason[~active] = 0
+        self.done |= outcome.terminated | outcome.truncated
+        going = (targets[..., 0] >= 0) & ~worlds.reached
+        self.heading = np.where(going[..., None], targets, 0)
+        self.targets, self.padding, self.oscillation = targets, padding, oscillation
+        self.new_cells, self.outcome = new_cells, outcome
+
+    # ------------------------------------------------------------------ views
+    def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:
+        """The robots' observations of ``worlds``, ``(len(worlds), K, ...)`` per key."""
+        slots = self.slots
+        positions = self.worlds.positions[worlds]
+        count = positions.shape[0] * self.n_agents
+        mates = self._teammates(worlds)
+        batch = self.encoder.encode_batch(
+            slots.centroid[worlds].reshape(count, self.n_slots, 2),
+            slots.valid[worlds].reshape(count, self.n_slots),
+            slots.distance[worlds].reshape(count, self.n_slots),
+            slots.gain[worlds].reshape(count, self.n_slots),
+            slots.mask[worlds].reshape(count, self.n_slots),
+            positions.reshape(count, 2),
+            None if mates is None else mates.reshape(count, -1),
+        )
+        shape = (positions.shape[0], self.n_agents)
+        if isinstance(batch, dict):
+            return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}
+        return batch.reshape(*shape, *batch.shape[1:])
+
+    def _teammates(self, worlds: np.ndarray | slice) -> np.ndarray | None:
+        layout = self.cfg.observation.teammates
+        if layout == "none":
+            return None
+        positions = self.worlds.positions[worlds].astype(np.float64)
+        if layout == "positions":
+            return teammate_rows(positions)
+        return teammate_rows(np.concatenate([positions, self.heading[worlds]], axis=2))
+
+    def explored_fraction(self, basis: str) -> np.ndarray:
+        """Per world, the explored fraction on ``basis`` (``all``, ``free``, ``reachable``)."""
+        return self.worlds.explored_fraction(basis)
