@@ -200,8 +200,12 @@ class NullVecEnv:
                 infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
                 if done:
                     self._t = 0
-                    for info in infos:
-                        info["terminal_observation"] = self._obs
+                    for j, info in enumerate(infos):
+                        info["terminal_observation"] = (
+                            {k: v[j] for k, v in self._obs.items()}
+                            if isinstance(self._obs, dict)
+                            else self._obs[j]
+                        )
                 dones = np.full(self.num_envs, done)
                 return self._obs, np.zeros(self.num_envs, np.float32), dones, infos
 
@@ -278,13 +282,15 @@ def main() -> None:
     parser.add_argument("--ppo-steps", type=int, default=100_000)
     parser.add_argument("--chunks", type=int, default=10)
     parser.add_argument("--skip-training", action="store_true")
+    parser.add_argument("--skip-decisions", action="store_true")
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args()
     report: dict[str, Any] = {
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
-        "decisions": decisions_table(args.seconds),
     }
+    if not args.skip_decisions:
+        report["decisions"] = decisions_table(args.seconds)
     if not args.skip_training:
         report["training"] = []
         for algorithm, n_envs, steps in (("dqn", 8, args.dqn_steps), ("ppo", 16, args.ppo_steps)):

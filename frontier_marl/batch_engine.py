@@ -49,7 +49,7 @@ class BatchMDP:
         self.steps_without_progress = np.zeros(n, dtype=np.int64)
         self.done = np.ones(n, dtype=bool)
         self.targets = np.full((n, k, 2), -1, dtype=np.int64)
-        self.heading = np.zeros((n, k, 2), dtype=np.int64)  # current targets, 0 when none
+        self.heading = np.full((n, k, 2), -1, dtype=np.int64)  # current targets, -1: none
         self.padding = np.zeros((n, k), dtype=bool)
         self.oscillation = np.zeros((n, k), dtype=bool)
         self.new_cells = np.zeros((n, k), dtype=np.int64)
@@ -69,7 +69,7 @@ class BatchMDP:
         self.steps_without_progress[worlds] = 0
         self.done[worlds] = False
         self.targets[worlds] = -1
-        self.heading[worlds] = 0
+        self.heading[worlds] = -1
         self.padding[worlds] = False
         self.oscillation[worlds] = False
         self.new_cells[worlds] = 0
@@ -88,6 +88,7 @@ class BatchMDP:
         padding = ~chosen & (live > 0) & active[:, None]
         oscillation = self._oscillation.update(targets)
         worlds = self.worlds
+        before = worlds.travelled.copy()
         worlds.move(targets, active)
         new_cells = np.where(active[:, None], worlds.new_cells, 0)
         self.steps += active
@@ -106,6 +107,7 @@ class BatchMDP:
             (slots.live == 0).all(axis=1),
             self.steps,
             self.steps_without_progress,
+            worlds.travelled - before,
         )
         # inactive worlds keep their state: no reward, no new end
         outcome.rewards[~active] = 0.0
@@ -114,27 +116,23 @@ class BatchMDP:
         outcome.reason[~active] = 0
         self.done |= outcome.terminated | outcome.truncated
         going = (targets[..., 0] >= 0) & ~worlds.reached
-        self.heading = np.where(going[..., None], targets, 0)
+        self.heading = np.where(going[..., None], targets, -1)
         self.targets, self.padding, self.oscillation = targets, padding, oscillation
         self.new_cells, self.outcome = new_cells, outcome
 
     # ------------------------------------------------------------------ views
     def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:
         """The robots' observations of ``worlds``, ``(len(worlds), K, ...)`` per key."""
-        slots = self.slots
         positions = self.worlds.positions[worlds]
-        count = positions.shape[0] * self.n_agents
+        shape = positions.shape[:2]
+        count = shape[0] * shape[1]
         mates = self._teammates(worlds)
         batch = self.encoder.encode_batch(
-            slots.centroid[worlds].reshape(count, self.n_slots, 2),
-            slots.valid[worlds].reshape(count, self.n_slots),
-            slots.distance[worlds].reshape(count, self.n_slots),
-            slots.gain[worlds].reshape(count, self.n_slots),
-            slots.mask[worlds].reshape(count, self.n_slots),
+            self.slots.rows(worlds),
             positions.reshape(count, 2),
             None if mates is None else mates.reshape(count, -1),
+            self.heading[worlds].reshape(count, 2),
         )
-        shape = (positions.shape[0], self.n_agents)
         if isinstance(batch, dict):
             return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}
         return batch.reshape(*shape, *batch.shape[1:])
@@ -146,7 +144,8 @@ class BatchMDP:
         positions = self.worlds.positions[worlds].astype(np.float64)
         if layout == "positions":
             return teammate_rows(positions)
-        return teammate_rows(np.concatenate([positions, self.heading[worlds]], axis=2))
+        heading = np.maximum(self.heading[worlds], 0)  # zeros where none
+        return teammate_rows(np.concatenate([positions, heading], axis=2))
 
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world, the explored fraction on ``basis`` (``all``, ``free``, ``reachable``)."""

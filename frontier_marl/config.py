@@ -32,8 +32,9 @@ StartCells = Literal["largest-component", "any-free"]
 SensorModel = Literal["square", "raycast"]
 GainModel = Literal["size", "unknown"]
 ThresholdBasis = Literal["all", "free", "reachable"]
-RewardKind = Literal["reward1", "reward2"]
+RewardKind = Literal["reward1", "reward2", "travel"]
 TeammateEncoding = Literal["none", "positions", "positions+targets"]
+FeatureLayout = Literal["thesis", "explorer"]
 FULL_PATH = "full"
 
 _CENTROIDS = ("absolute", "relative", "distance", "none")
@@ -43,8 +44,9 @@ _START_CELLS = ("largest-component", "any-free")
 _SENSORS = ("square", "raycast")
 _GAINS = ("size", "unknown")
 _BASES = ("all", "free", "reachable")
-_REWARDS = ("reward1", "reward2")
+_REWARDS = ("reward1", "reward2", "travel")
 _TEAMMATES = ("none", "positions", "positions+targets")
+_FEATURES = ("thesis", "explorer")
 
 
 @dataclass(frozen=True)
@@ -63,6 +65,10 @@ class ObservationConfig:
         teammates: add a ``teammates`` key to the ``Dict`` observation: the other robots'
             ``positions`` (row, col each, in agent order), or ``positions+targets`` (also the
             cell each is heading to; zeros before its first decision or when idle).
+        features: ``thesis`` (the layout the axes above describe) or ``explorer``: per-slot
+            features that do not depend on the map size (path length, gain, isolation, ...;
+            :mod:`frontier_marl.slot_features`), a ``Dict`` of ``slots`` and ``action_mask``;
+            the axes above are then unused.
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -72,8 +78,10 @@ class ObservationConfig:
     action_mask: bool = False
     normalize: bool = False
     teammates: TeammateEncoding = "none"
+    features: FeatureLayout = "thesis"
 
     def validate(self) -> None:
+        check_choice("features", self.features, _FEATURES)
         check_choice("centroid", self.centroid, _CENTROIDS)
         check_choice("teammates", self.teammates, _TEAMMATES)
         for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
@@ -87,7 +95,12 @@ class ObservationConfig:
     @property
     def is_dict(self) -> bool:
         """Whether the observation space is a ``Dict`` (else a flat ``Box``)."""
-        return self.agent_position or self.action_mask or self.teammates != "none"
+        return (
+            self.agent_position
+            or self.action_mask
+            or self.teammates != "none"
+            or self.features == "explorer"
+        )
 
 
 @dataclass(frozen=True)
@@ -95,7 +108,10 @@ class RewardConfig:
     """The thesis's two reward tables (docs/environment.md) and their open parameters.
 
     Attributes:
-        kind: ``reward1`` (harsh, padding truncates) or ``reward2`` (soft, oscillation penalty).
+        kind: ``reward1`` (harsh, padding truncates), ``reward2`` (soft, oscillation penalty),
+            or ``travel`` (beyond the thesis, aligned with the distance metrics T90/T99: each
+            robot pays ``travel_cost`` per cell it walked, an idle step counting as one cell,
+            instead of the no-new-cell and oscillation terms).
         explore_threshold: explored fraction that ends the episode well (open choice;
             0.85 by calibration, docs/calibration.md).
         threshold_basis: what the fraction counts: ``all`` cells known, ``free`` true-free
@@ -113,7 +129,8 @@ class RewardConfig:
         cell_reward: reward per newly known cell.
         no_new_cell_penalty, padding_penalty, goal_bonus, step_limit_penalty,
         no_progress_penalty, oscillation_penalty: the table's constants; ``padding_penalty``
-            defaults by ``kind`` (-1.0 for Reward 1, -0.1 for Reward 2) when left ``None``.
+            defaults by ``kind`` (-1.0 for Reward 1, -0.1 otherwise) when left ``None``.
+        travel_cost: the ``travel`` reward's term per cell walked (idle: one cell).
     """
 
     kind: RewardKind = "reward2"
@@ -130,6 +147,7 @@ class RewardConfig:
     step_limit_penalty: float = -1.0
     no_progress_penalty: float = -0.5
     oscillation_penalty: float = -0.05
+    travel_cost: float = -0.02
 
     def validate(self) -> None:
         check_choice("reward", self.kind, _REWARDS)
@@ -146,6 +164,7 @@ class RewardConfig:
             "step_limit_penalty",
             "no_progress_penalty",
             "oscillation_penalty",
+            "travel_cost",
         ):
             check_finite(name, getattr(self, name))
         if self.padding_penalty is not None:

@@ -19,6 +19,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotTable
 from frontier_marl.core.world import MoveResult, World
+from frontier_marl.core.worlds import SlotArrays
 from frontier_marl.episodes import EpisodeSource, world_params
 from frontier_marl.observations import ObservationEncoder, teammate_rows
 from frontier_marl.rewards import OscillationHistory, StepEvents, StepOutcome, step_outcome
@@ -102,6 +103,7 @@ class ExplorationMDP:
                 padding[agent] = table.live > 0
         oscillation = self._oscillation.update(targets[None])[0]
         world = self.world
+        before = world.travelled.copy()
         moved = world.move(targets)
         self.steps += 1
         new_cells = moved.new_cells.tolist()
@@ -116,6 +118,7 @@ class ExplorationMDP:
             no_frontier_left=not any(table.live for table in self._slots),
             steps_taken=self.steps,
             steps_without_progress=self.steps_without_progress,
+            moved=world.travelled - before,
         )
         outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
@@ -175,26 +178,28 @@ class ExplorationMDP:
         after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        mates = self._teammate_table(positions, targets, reached)
-        tables = self._slots
+        heading = self._heading(targets, reached)
+        mates = self._teammate_table(positions, heading)
         batch = self.encoder.encode_batch(
-            np.stack([table.centroid for table in tables]),
-            np.stack([table.valid for table in tables]),
-            np.stack([table.distance for table in tables]),
-            np.stack([table.gain for table in tables]),
-            np.stack([table.mask for table in tables]),
+            SlotArrays.stack(self._slots),
             positions,
             None if mates is None else teammate_rows(mates),
+            heading,
         )
         if isinstance(batch, dict):
-            return [
-                {key: value[agent] for key, value in batch.items()} for agent in range(len(tables))
-            ]
+            agents = range(len(self._slots))
+            return [{key: value[agent] for key, value in batch.items()} for agent in agents]
         return list(batch)
 
-    def _teammate_table(
-        self, positions: np.ndarray, targets: np.ndarray | None, reached: np.ndarray | None
-    ) -> np.ndarray | None:
+    def _heading(self, targets: np.ndarray | None, reached: np.ndarray | None) -> np.ndarray:
+        """(N, 2) the cells the robots are heading to: the step's targets not reached yet
+        (row -1: none, as before the first decision)."""
+        if targets is None or reached is None:
+            return np.full((self.cfg.n_agents, 2), -1, dtype=np.int64)
+        going = (targets[:, 0] >= 0) & ~reached
+        return np.where(going[:, None], targets, -1)
+
+    def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (zeros where a robot has
         none: before its first decision, idle, or on its target); None if not observed."""
         layout = self.cfg.observation.teammates
@@ -202,8 +207,4 @@ class ExplorationMDP:
             return None
         if layout == "positions":
             return positions.astype(np.float64)
-        heading = np.zeros((len(positions), 2))
-        if targets is not None:
-            going = (targets[:, 0] >= 0) & ~reached
-            heading[going] = targets[going]
-        return np.concatenate([positions, heading], axis=1)
+        return np.concatenate([positions, np.maximum(heading, 0)], axis=1).astype(np.float64)

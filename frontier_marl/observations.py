@@ -27,6 +27,8 @@ from gymnasium import spaces
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotTable
+from frontier_marl.core.worlds import SlotArrays
+from frontier_marl.slot_features import EXPLORER_FEATURES, explorer_features, explorer_space
 
 
 class ObservationEncoder:
@@ -43,6 +45,11 @@ class ObservationEncoder:
         self.is_dict = obs.is_dict
         self.teammates = obs.teammates
         self.normalize = obs.normalize
+        self.features = obs.features
+        if self.features == "explorer":
+            self.features_per_slot = len(EXPLORER_FEATURES)
+            self.space: spaces.Space[Any] = explorer_space(self.n_slots)
+            return
         height, width = cfg.height, cfg.width
         cells = cfg.max_cluster_cells
         gain_high = min(float(cells if cfg.gain == "size" else 8 * cells), float(height * width))
@@ -72,7 +79,7 @@ class ObservationEncoder:
         high_arr = np.tile(np.array(high) / self._scale, self.n_slots).astype(np.float32)
         cluster_space = spaces.Box(low_arr, high_arr, dtype=np.float32)
         if not self.is_dict:
-            self.space: spaces.Space[Any] = cluster_space
+            self.space = cluster_space
             return
         entries: dict[str, spaces.Space[Any]] = {"clusters": cluster_space}
         if self.agent_position:
@@ -94,20 +101,19 @@ class ObservationEncoder:
         slots: SlotTable,
         position: np.ndarray,
         teammates: np.ndarray | None = None,
+        heading: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
         """The observation of a robot at ``position`` with slot table ``slots``.
 
         ``teammates`` is (N-1, 2) or (N-1, 4): the other robots' (row, col) positions, and
         targets for ``positions+targets``; needed only when the layout includes teammates.
+        ``heading``: the cell the robot is heading to (row -1: none), for the explorer layout.
         """
         batch = self.encode_batch(
-            slots.centroid[None],
-            slots.valid[None],
-            slots.distance[None],
-            slots.gain[None],
-            slots.mask[None],
+            SlotArrays.stack([slots]),
             np.asarray(position)[None],
             None if teammates is None else np.asarray(teammates).reshape(1, -1),
+            None if heading is None else np.asarray(heading).reshape(1, 2),
         )
         if isinstance(batch, dict):
             return {key: value[0] for key, value in batch.items()}
@@ -115,33 +121,38 @@ class ObservationEncoder:
 
     def encode_batch(
         self,
-        centroid: np.ndarray,
-        valid: np.ndarray,
-        distance: np.ndarray,
-        gain: np.ndarray,
-        mask: np.ndarray,
+        slots: SlotArrays,
         positions: np.ndarray,
         teammates: np.ndarray | None = None,
+        heading: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
-        """The observations of M robots at once: slot fields ``(M, n_slots, ...)`` as in
-        :class:`SlotTable`, ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened
-        per robot. Returns the ``(M, ...)`` array, or a dict of them, of :attr:`space`'s layout.
-        """
+        """The observations of M robots at once: ``slots`` with ``(M, n_slots, ...)`` fields,
+        ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened per robot,
+        ``heading`` (M, 2) the cells they head to (row -1: none; default none). Returns the
+        ``(M, ...)`` array, or a dict of them, in :attr:`space`'s layout."""
+        if self.features == "explorer":
+            if heading is None:
+                heading = np.full_like(positions, -1)
+            return {
+                "slots": explorer_features(slots, positions, heading),
+                "action_mask": np.array(slots.mask, dtype=np.int8),
+            }
         dtype = np.float64 if self.normalize else np.float32  # normalize in float64
         count = len(positions)
         features = np.zeros((count, self.n_slots, self.features_per_slot), dtype=dtype)
         column = 0
         if self.centroid == "absolute":
-            features[..., 0:2] = centroid  # padding slots hold zeros
+            features[..., 0:2] = slots.centroid  # padding slots hold zeros
             column = 2
         elif self.centroid == "relative":
-            features[..., 0:2] = np.where(valid[..., None], centroid - positions[:, None, :], 0.0)
+            relative = slots.centroid - positions[:, None, :]
+            features[..., 0:2] = np.where(slots.valid[..., None], relative, 0.0)
             column = 2
         elif self.centroid == "distance":
-            features[..., 0] = distance
+            features[..., 0] = slots.distance
             column = 1
         if self.info_gain:
-            features[..., column] = gain
+            features[..., column] = slots.gain
         if self.normalize:
             features = (features / self._scale).astype(np.float32)
         flat = features.reshape(count, -1)
@@ -155,7 +166,7 @@ class ObservationEncoder:
                 else positions.astype(np.float32)
             )
         if self.action_mask:
-            out["action_mask"] = np.array(mask, dtype=np.int8)
+            out["action_mask"] = np.array(slots.mask, dtype=np.int8)
         if self.teammates != "none":
             if teammates is None:
                 raise ValueError("this observation layout needs the teammates' positions")

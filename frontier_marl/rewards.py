@@ -88,6 +88,7 @@ class StepEvents:
     no_frontier_left: bool
     steps_taken: int  # decision steps so far, this one included
     steps_without_progress: int  # consecutive, this one included
+    moved: Sequence[int] | None = None  # cells each robot walked (the travel reward's term)
 
 
 @dataclass(slots=True)
@@ -131,16 +132,23 @@ def batch_outcome(
     no_frontier_left: np.ndarray,
     steps_taken: np.ndarray,
     steps_without_progress: np.ndarray,
+    moved: np.ndarray | None = None,
 ) -> BatchOutcome:
     """Apply the reward table to one step of W worlds of N robots: per-robot arrays are
-    ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched)."""
+    ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched);
+    ``moved`` (cells walked) is needed by the ``travel`` reward only."""
     weight = cfg.team_weight
     if weight:
         credited = (1.0 - weight) * new_cells + weight * new_cells.sum(axis=1, keepdims=True)
     else:
         credited = new_cells
     rewards = cfg.cell_reward * credited
-    rewards = rewards + np.where(new_cells == 0, cfg.no_new_cell_penalty, 0.0)
+    if cfg.kind == "travel":
+        if moved is None:
+            raise ValueError("the travel reward needs the cells each robot walked")
+        rewards = rewards + cfg.travel_cost * np.maximum(moved, 1)
+    else:
+        rewards = rewards + np.where(new_cells == 0, cfg.no_new_cell_penalty, 0.0)
     rewards = rewards + np.where(padding, cfg.padding, 0.0)
     if cfg.kind == "reward2":
         rewards = rewards + np.where(oscillation, cfg.oscillation_penalty, 0.0)
@@ -171,6 +179,7 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
         np.array([events.no_frontier_left]),
         np.array([events.steps_taken]),
         np.array([events.steps_without_progress]),
+        None if events.moved is None else np.asarray(events.moved, dtype=np.int64)[None],
     )
     return StepOutcome(
         outcome.rewards[0],

@@ -87,6 +87,8 @@ BAD_VALUES = [
     ("no_progress_penalty", "x", "no_progress_penalty"),
     ("oscillation_penalty", math.inf, "oscillation_penalty"),
     ("reward", "reward3", "reward"),
+    ("travel_cost", math.nan, "travel_cost"),
+    ("features", "pixels", "features"),
     ("foo", 1, "foo"),
     ("preset", "thesis-10x10", "preset"),
     ("config", "thesis-20x20", "config"),

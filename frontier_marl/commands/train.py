@@ -1,4 +1,4 @@
-"""``frontier-marl train``: train DQN on one experiment config (SB3 through SuperSuit).
+"""``frontier-marl train``: train DQN on one experiment config (SB3 on the batched vector env).
 
 Examples::
 

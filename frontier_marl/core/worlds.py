@@ -13,6 +13,7 @@ Arrays are indexed ``[world, ...]`` and ``[world, robot, ...]``; read them, neve
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,9 +31,12 @@ from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.movement import walk
 from frontier_marl.core.sensing import Sensor, reveal
-from frontier_marl.core.slots import _robot_slots
+from frontier_marl.core.slots import SlotTable, _robot_slots
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
+_FIELDS = (
+    "cluster", "valid", "centroid", "target", "distance", "size", "gain", "path_length", "mask"
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -48,8 +52,8 @@ class WorldParams:
 
 @dataclass(slots=True)
 class SlotArrays:
-    """The slots of every robot, fields of :class:`~frontier_marl.core.slots.SlotTable` with
-    leading ``(N, K)`` axes; fresh arrays each time they are computed."""
+    """The slots of many robots: the fields of :class:`~frontier_marl.core.slots.SlotTable`
+    with leading axes, ``(N, K)`` (world, robot) in a batch or ``(M,)`` for M robots."""
 
     cluster: np.ndarray  # int (N, K, S)
     valid: np.ndarray  # bool (N, K, S)
@@ -61,6 +65,20 @@ class SlotArrays:
     path_length: np.ndarray  # int (N, K, S)
     mask: np.ndarray  # int8 (N, K, S)
     live: np.ndarray  # int (N, K)
+
+    @classmethod
+    def stack(cls, tables: Sequence[SlotTable]) -> SlotArrays:
+        """The tables of M robots as ``(M, ...)`` arrays."""
+        fields = {name: np.stack([getattr(t, name) for t in tables]) for name in _FIELDS}
+        return cls(**fields, live=np.array([t.live for t in tables], dtype=np.int64))
+
+    def rows(self, worlds: np.ndarray | slice) -> SlotArrays:
+        """The robots of ``worlds`` of a batch as ``(M, ...)`` arrays, world after world."""
+        fields = {name: getattr(self, name)[worlds] for name in (*_FIELDS, "live")}
+        count = fields["live"].size
+        return SlotArrays(
+            **{name: value.reshape(count, *value.shape[2:]) for name, value in fields.items()}
+        )
 
     @classmethod
     def empty(cls, n_worlds: int, n_agents: int, n_slots: int) -> SlotArrays:

@@ -85,7 +85,7 @@ class BatchedVecEnv(VecEnv):
         self.env.close()
 
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
-        return [getattr(self.env, attr_name, None)] * len(self._indices(indices))
+        return [getattr(self.env, attr_name, None)] * len(env_indices(indices, self.num_envs))
 
     def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
         raise AttributeError(f"{type(self).__name__} has no per-env attributes to set")
@@ -95,18 +95,20 @@ class BatchedVecEnv(VecEnv):
     ) -> list[Any]:
         if method_name != "action_masks":
             raise AttributeError(f"{type(self).__name__} has no env method {method_name!r}")
-        return list(self.action_masks()[self._indices(indices)])
+        return list(self.action_masks()[env_indices(indices, self.num_envs)])
 
     def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
-        return [False] * len(self._indices(indices))
+        return [False] * len(env_indices(indices, self.num_envs))
 
-    def _indices(self, indices: Any) -> list[int]:
-        if indices is None:
-            return list(range(self.num_envs))
-        if isinstance(indices, int):
-            return [indices]
-        assert isinstance(indices, Iterable)
-        return list(indices)
+
+def env_indices(indices: Any, num_envs: int) -> list[int]:
+    """SB3's ``indices`` argument (None, an int or an iterable) as a list."""
+    if indices is None:
+        return list(range(num_envs))
+    if isinstance(indices, int):
+        return [indices]
+    assert isinstance(indices, Iterable)
+    return list(indices)
 
 
 def make_batched_vec_env(
@@ -114,15 +116,88 @@ def make_batched_vec_env(
     n_envs: int = 1,
     seed: int | None = None,
     bootstrap_truncations: bool = True,
+    seed_range: range | None = None,
 ) -> VecMonitor:
     """An SB3 ``VecMonitor`` over :class:`BatchedVecEnv`; with ``seed`` world ``i`` is reset
     once with SuperSuit copy ``i``'s seed, as :func:`~frontier_marl.training.vec_env.make_vec_env`
-    does."""
+    does, mapped into ``seed_range`` when given (e.g. a map family's training seeds)."""
     if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
         raise ValueError(f"n_envs must be an integer >= 1, got {n_envs!r}")
     vec = BatchedVecEnv(env_kwargs, n_envs, bootstrap_truncations)
     if seed is not None:
-        vec.seed_worlds(copy_seeds(seed, n_envs))
+        seeds = copy_seeds(seed, n_envs)
+        if seed_range is not None:
+            seeds = [seed_range[s % len(seed_range)] for s in seeds]
+        vec.seed_worlds(seeds)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="The `render_mode` attribute is not defined")
         return VecMonitor(vec)
+
+
+class MixedVecEnv(VecEnv):
+    """Several SB3 vector envs of one observation space side by side (e.g. one batch per map
+    family, whose grids differ in size): slots of the first, then of the second, ..."""
+
+    def __init__(self, parts: Sequence[VecEnv]) -> None:
+        first = parts[0]
+        for part in parts[1:]:
+            if part.observation_space != first.observation_space:
+                raise ValueError(
+                    "every part of a mixed vector env needs the same observation space, got "
+                    f"{first.observation_space} and {part.observation_space}"
+                )
+        self.parts = list(parts)
+        self._bounds = np.cumsum([0, *(part.num_envs for part in parts)])
+        super().__init__(int(self._bounds[-1]), first.observation_space, first.action_space)
+
+    def reset(self) -> Any:
+        return self._join([part.reset() for part in self.parts])
+
+    def step_async(self, actions: np.ndarray) -> None:
+        for part, low, high in zip(self.parts, self._bounds[:-1], self._bounds[1:], strict=True):
+            part.step_async(actions[low:high])
+
+    def step_wait(self) -> tuple[Any, np.ndarray, np.ndarray, list[dict[str, Any]]]:
+        results = [part.step_wait() for part in self.parts]
+        observations = self._join([result[0] for result in results])
+        rewards = np.concatenate([result[1] for result in results])
+        dones = np.concatenate([result[2] for result in results])
+        infos = [info for result in results for info in result[3]]
+        return observations, rewards, dones, infos
+
+    def action_masks(self) -> np.ndarray:
+        return np.concatenate([np.stack(part.env_method("action_masks")) for part in self.parts])
+
+    def seed(self, seed: int | None = None) -> Sequence[None | int]:
+        return [
+            s
+            for i, part in enumerate(self.parts)
+            for s in part.seed(None if seed is None else seed + 1000 * i)
+        ]
+
+    def close(self) -> None:
+        for part in self.parts:
+            part.close()
+
+    def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
+        values = [value for part in self.parts for value in part.get_attr(attr_name)]
+        return [values[i] for i in env_indices(indices, self.num_envs)]
+
+    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+        raise AttributeError(f"{type(self).__name__} has no per-env attributes to set")
+
+    def env_method(
+        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
+    ) -> list[Any]:
+        if method_name != "action_masks":
+            raise AttributeError(f"{type(self).__name__} has no env method {method_name!r}")
+        return list(self.action_masks()[env_indices(indices, self.num_envs)])
+
+    def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
+        return [False] * len(env_indices(indices, self.num_envs))
+
+    @staticmethod
+    def _join(observations: list[Any]) -> Any:
+        if isinstance(observations[0], dict):
+            return {key: np.concatenate([o[key] for o in observations]) for key in observations[0]}
+        return np.concatenate(observations)

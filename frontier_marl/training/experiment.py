@@ -55,6 +55,7 @@ _RESERVED_DQN = {
 
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
+POLICIES = ("auto", "slot-scorer")
 
 
 @dataclass(frozen=True)
@@ -89,6 +90,14 @@ class TrainSettings:
         validation_episodes: episodes per validation.
         validation_seed: first reset seed of the validation episodes; the range must not
             overlap the evaluation's (``eval_seed`` .. ``eval_seed + eval_episodes - 1``).
+        policy: ``auto`` (SB3's ``MlpPolicy`` or ``MultiInputPolicy``, by observation) or
+            ``slot-scorer`` (the masked, permutation-equivariant Q-network of
+            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; needs
+            ``features = "explorer"``).
+        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.benchmark`),
+            ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
+            range; ``[env]`` then sets the observation and reward (not the map). Empty: the
+            ``[env]`` world.
     """
 
     total_timesteps: int = 1_000_000
@@ -107,6 +116,8 @@ class TrainSettings:
     validate_every: int = 0
     validation_episodes: int = 30
     validation_seed: int = 1000
+    policy: str = "auto"
+    families: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name, low in (
@@ -126,6 +137,24 @@ class TrainSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if self.policy not in POLICIES:
+            raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
+        if not isinstance(self.families, tuple) or not all(
+            isinstance(name, str) for name in self.families
+        ):
+            raise ValueError(
+                f"train.families must be a list of family names, got {self.families!r}"
+            )
+        if self.families:
+            from frontier_marl.evaluation.benchmark import family
+
+            for name in self.families:
+                try:
+                    family(name)
+                except ValueError as exc:
+                    raise ValueError(f"train.families: {exc}") from None
+            if self.vec_env != "batched":
+                raise ValueError("train.families needs train.vec_env = 'batched'")
         if self.vec_env not in VEC_ENVS:
             raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
         if not isinstance(self.bootstrap_truncations, bool):
@@ -168,10 +197,20 @@ class Experiment:
     source: str | None = None
 
     def env_config(self) -> EnvConfig:
-        """The validated env config (raises ``ValueError`` naming a bad env key)."""
+        """The validated env config (raises ``ValueError`` naming a bad env key); with
+        ``train.families``, the first family's."""
+        return self.env_configs()[0]
+
+    def env_configs(self) -> list[EnvConfig]:
+        """One env config per training family (``[env]`` on each family's world), or the
+        ``[env]`` config alone."""
+        if self.train.families:
+            from frontier_marl.evaluation.benchmark import family, variant_configs
+
+            return [variant_configs(family(name), self.env)[0] for name in self.train.families]
         kwargs = dict(self.env)
         preset = kwargs.pop("preset", "thesis-20x20")
-        return make_config(preset, **kwargs)
+        return [make_config(preset, **kwargs)]
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON/TOML-able dictionary that :func:`experiment_from_dict` reads back."""
@@ -180,7 +219,7 @@ class Experiment:
             "description": self.description,
             "env": dict(self.env),
             "dqn": dict(self.dqn),
-            "train": dataclasses.asdict(self.train),
+            "train": {**dataclasses.asdict(self.train), "families": list(self.train.families)},
         }
 
 
@@ -212,6 +251,8 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         env["map_path"] = str(example_map_path(map_name))  # a shipped example map by name
     dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
     train_kw = dict(data.get("train", {}))
+    if isinstance(train_kw.get("families"), list):
+        train_kw["families"] = tuple(train_kw["families"])
     bad_train = set(train_kw) - _TRAIN_KEYS
     if bad_train:
         raise ValueError(

@@ -118,6 +118,42 @@ def resume_experiment(
     return experiment_from_dict(data, source=str(checkpoint.path))
 
 
+def training_vec_env(experiment: Experiment, seed: int) -> Any:
+    """The SB3 vector env of ``experiment`` (see :class:`TrainSettings`' ``vec_env``,
+    ``n_envs`` and ``families``), its worlds seeded from ``seed``."""
+    from frontier_marl.training.batched_vec_env import MixedVecEnv, make_batched_vec_env
+    from frontier_marl.training.vec_env import make_vec_env
+
+    settings = experiment.train
+    bootstrap = settings.bootstrap_truncations
+    if not settings.families:
+        make = make_batched_vec_env if settings.vec_env == "batched" else make_vec_env
+        return make({"config": experiment.env_config()}, settings.n_envs, seed, bootstrap)
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from frontier_marl.evaluation.benchmark import family
+
+    parts = []
+    for i, (name, cfg) in enumerate(zip(settings.families, experiment.env_configs(), strict=True)):
+        seeds = family(name).train
+        part = make_batched_vec_env(
+            {"config": cfg}, settings.n_envs, seed + 1000 * i, bootstrap, seed_range=seeds
+        )
+        parts.append(part.venv)  # one VecMonitor around the mix
+    return VecMonitor(MixedVecEnv(parts))
+
+
+def learner(policy: str) -> tuple[Any, Any]:
+    """The SB3 algorithm class and policy class (None: by observation) of ``train.policy``."""
+    if policy == "slot-scorer":
+        from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
+
+        return MaskedDQN, SlotDQNPolicy
+    from stable_baselines3 import DQN
+
+    return DQN, None
+
+
 def train(
     experiment: Experiment,
     run_dir: str | Path,
@@ -133,11 +169,7 @@ def train(
     raised anywhere in ``learn`` ends the session like Ctrl-C: checkpoint, model, no evaluation.
     """
     import torch
-    from stable_baselines3 import DQN
     from stable_baselines3.common.utils import set_random_seed
-
-    from frontier_marl.training.batched_vec_env import make_batched_vec_env
-    from frontier_marl.training.vec_env import make_vec_env
 
     settings: TrainSettings = experiment.train
     run_dir = Path(run_dir)
@@ -157,17 +189,12 @@ def train(
     start_step = 0 if checkpoint is None else checkpoint.step
     seed = session_seed(settings.seed, start_step)
     set_random_seed(seed)
-    make = make_batched_vec_env if settings.vec_env == "batched" else make_vec_env
-    vec_env = make(
-        {"config": cfg},
-        settings.n_envs,
-        seed=seed,
-        bootstrap_truncations=settings.bootstrap_truncations,
-    )
+    vec_env = training_vec_env(experiment, seed)
+    algorithm, policy_class = learner(settings.policy)
     if checkpoint is None:
         try:
-            model = DQN(
-                policy_name(vec_env.observation_space),
+            model = algorithm(
+                policy_class or policy_name(vec_env.observation_space),
                 vec_env,
                 device=settings.device,
                 verbose=verbose,
@@ -177,7 +204,7 @@ def train(
             vec_env.close()
             raise ValueError(f"[dqn] settings rejected by stable_baselines3.DQN: {exc}") from exc
     else:
-        model = DQN.load(checkpoint.model, env=vec_env, device=settings.device)
+        model = algorithm.load(checkpoint.model, env=vec_env, device=settings.device)
         if checkpoint.replay_buffer.is_file():
             model.load_replay_buffer(checkpoint.replay_buffer)
         start_step = model.num_timesteps

@@ -1,0 +1,75 @@
+"""The ``explorer`` observation: per-slot features that do not depend on the map's size.
+
+``{"slots": (n_slots, F) float32, "action_mask": (n_slots,) int8}``; padding slots are all
+zeros. Lengths are in cells divided by :data:`CELLS` (32), so the same robot situation gives the
+same features on a 20x20 grid and on a 64x64 floor plan. Per slot, in order
+(:data:`EXPLORER_FEATURES`):
+
+``path``        known-free shortest path from the robot to the slot's target
+``distance``    Euclidean distance from the robot to the cluster's centroid
+``d_row``, ``d_col``   the target relative to the robot
+``size``        frontier cells of the cluster / 16
+``gain``        the information gain / 64 (unknown cells around it with ``gain="unknown"``)
+``isolation``   Euclidean distance from the centroid to the nearest other slot's centroid
+``extra_path``  ``path`` minus the shortest ``path`` of all slots (0 for the nearest)
+``current``     1 if the slot's target is the cell the robot is heading to
+``live``        the number of live slots / n_slots (the same on every slot)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from gymnasium import spaces
+
+from frontier_marl.core.worlds import SlotArrays
+
+CELLS = 32.0  # the length unit of the features, in cells
+EXPLORER_FEATURES = (
+    "path", "distance", "d_row", "d_col", "size", "gain", "isolation", "extra_path", "current",
+    "live",
+)  # fmt: skip
+_BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
+
+
+def explorer_space(n_slots: int) -> spaces.Dict:
+    """The explorer layout's observation space (the same for every map size)."""
+    return spaces.Dict(
+        {
+            "slots": spaces.Box(-_BOUND, _BOUND, (n_slots, len(EXPLORER_FEATURES)), np.float32),
+            "action_mask": spaces.Box(0, 1, (n_slots,), dtype=np.int8),
+        }
+    )
+
+
+def explorer_features(slots: SlotArrays, positions: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """(M, n_slots, F) features of M robots: ``slots`` with (M, n_slots) fields, ``positions``
+    and ``heading`` (M, 2), heading row -1 where a robot heads nowhere."""
+    valid = slots.valid
+    count, n_slots = valid.shape
+    path = np.where(valid, slots.path_length, 0).astype(np.float64)
+    relative = slots.target - positions[:, None, :]
+    centroid = slots.centroid
+    apart = np.linalg.norm(centroid[:, :, None, :] - centroid[:, None, :, :], axis=-1)
+    others = valid[:, :, None] & valid[:, None, :] & ~np.eye(n_slots, dtype=bool)
+    isolation = np.where(others, apart, np.inf).min(axis=2)
+    isolation = np.where(np.isfinite(isolation), isolation, 0.0)
+    nearest = np.where(valid, path, np.inf).min(axis=1, keepdims=True)
+    current = (slots.target == heading[:, None, :]).all(axis=-1) & (heading[:, None, 0] >= 0)
+    live = valid.sum(axis=1, keepdims=True) / n_slots
+    features = np.stack(
+        [
+            path / CELLS,
+            slots.distance / CELLS,
+            relative[..., 0] / CELLS,
+            relative[..., 1] / CELLS,
+            slots.size / 16.0,
+            slots.gain / 64.0,
+            isolation / CELLS,
+            np.where(valid, path - nearest, 0.0) / CELLS,
+            current,
+            np.broadcast_to(live, valid.shape),
+        ],
+        axis=-1,
+    )
+    features[~valid] = 0.0
+    return features.astype(np.float32).reshape(count, n_slots, len(EXPLORER_FEATURES))

@@ -1,0 +1,130 @@
+"""The learned explorer's parts: the size-independent slot features, the travel reward, the
+masked permutation-equivariant Q-network and the mixed vector env."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+import frontier_marl
+from frontier_marl.config import make_config
+from frontier_marl.core.slots import SlotTable
+from frontier_marl.core.worlds import SlotArrays
+from frontier_marl.rewards import StepEvents, step_outcome
+from frontier_marl.slot_features import CELLS, EXPLORER_FEATURES, explorer_features
+
+EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown"}
+
+
+def _table(targets: list[tuple[int, int]], paths: list[int], n_slots: int = 4) -> SlotTable:
+    live = len(targets)
+    pad = n_slots - live
+    target = np.array(targets + [(-1, -1)] * pad, dtype=np.int64)
+    return SlotTable.from_arrays(
+        cluster=np.array(list(range(live)) + [-1] * pad),
+        valid=np.array([True] * live + [False] * pad),
+        centroid=np.where(target >= 0, target, 0).astype(float),
+        target=target,
+        distance=np.array([float(np.hypot(*t)) for t in targets] + [0.0] * pad),
+        size=np.array([3] * live + [0] * pad),
+        gain=np.array([10.0] * live + [0.0] * pad),
+        path_length=np.array(paths + [-1] * pad),
+    )
+
+
+def test_explorer_features_on_a_hand_made_table() -> None:
+    table = _table([(0, 4), (3, 0)], [6, 3])
+    heading = np.array([[3, 0]])
+    features = explorer_features(SlotArrays.stack([table]), np.array([[0, 0]]), heading)[0]
+    column = {name: i for i, name in enumerate(EXPLORER_FEATURES)}
+    assert features.shape == (4, len(EXPLORER_FEATURES))
+    assert features[:, column["path"]].tolist() == pytest.approx([6 / CELLS, 3 / CELLS, 0, 0])
+    assert features[:, column["extra_path"]].tolist() == pytest.approx([3 / CELLS, 0, 0, 0])
+    assert features[:, column["isolation"]].tolist() == pytest.approx([5 / CELLS] * 2 + [0, 0])
+    assert features[:, column["current"]].tolist() == [0, 1, 0, 0]
+    assert features[:, column["live"]].tolist() == [0.5, 0.5, 0, 0]
+    assert features[:, column["d_row"]].tolist() == pytest.approx([0, 3 / CELLS, 0, 0])
+    assert not features[2:].any()  # padding slots are zeros
+
+
+def test_explorer_observation_does_not_depend_on_the_map_size() -> None:
+    small = frontier_marl.parallel_env(preset="thesis-20x20", **EXPLORER)
+    large = frontier_marl.parallel_env(preset="rooms-32", height=64, width=64, **EXPLORER)
+    assert small.observation_space("robot_0") == large.observation_space("robot_0")
+    observation, _ = large.reset(seed=3)
+    assert small.observation_space("robot_0").contains(observation["robot_0"])
+
+
+def test_travel_reward_charges_every_cell_walked_and_idle_steps() -> None:
+    cfg = make_config(reward="travel", travel_cost=-0.02, cell_reward=0.05).reward
+    events = StepEvents([4, 0], [False, False], [False, False], False, False, 3, 0, [1, 0])
+    assert step_outcome(cfg, events).rewards.tolist() == pytest.approx([0.18, -0.02])
+    with pytest.raises(ValueError, match="cells each robot walked"):
+        step_outcome(cfg, StepEvents([1], [False], [False], False, False, 1, 0))
+
+
+def test_batched_and_single_explorer_observations_agree() -> None:
+    kwargs = {**EXPLORER, "preset": "rooms-32", "reward": "travel", "map_mode": "dynamic"}
+    vec = frontier_marl.vector_env(2, **kwargs)
+    single = frontier_marl.parallel_env(**kwargs)
+    observations, infos = vec.reset(seed=4)
+    expected, _ = single.reset(seed=4)
+    for _ in range(30):
+        action = int(infos["action_mask"][0].argmax())
+        observations, rewards, *_, infos = vec.step(np.array([action, 0]))
+        expected, single_rewards, *_ = single.step({"robot_0": action})
+        assert np.array_equal(observations["slots"][0], expected["robot_0"]["slots"])
+        assert rewards[0] == single_rewards["robot_0"]
+
+
+def _slot_model(n_envs: int = 2):  # noqa: ANN202
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
+
+    torch.set_num_threads(1)
+    cfg = make_config("thesis-20x20", reward="travel", **EXPLORER)
+    env = make_batched_vec_env({"config": cfg}, n_envs, seed=0)
+    model = MaskedDQN(SlotDQNPolicy, env, learning_starts=50, buffer_size=500, batch_size=16)
+    return model, env
+
+
+def test_slot_q_network_is_permutation_equivariant_and_masks() -> None:
+    model, env = _slot_model()
+    observation = env.reset()
+    observation["action_mask"][:, 0] = 1
+    order = np.random.default_rng(0).permutation(observation["slots"].shape[1])
+    shuffled = {key: value[:, order] for key, value in observation.items()}
+    q_values = model.q_net(model.policy.obs_to_tensor(observation)[0])
+    q_shuffled = model.q_net(model.policy.obs_to_tensor(shuffled)[0])
+    assert torch.allclose(q_values[:, order], q_shuffled, atol=1e-5)
+    masked = torch.as_tensor(observation["action_mask"] == 0)
+    assert (q_values[masked] <= -1e8).all() and (q_values[~masked] > -1e8).all()
+
+
+def test_masked_dqn_only_ever_picks_valid_slots() -> None:
+    model, env = _slot_model()
+    model.exploration_rate = 1.0
+    observation = env.reset()
+    for _ in range(40):
+        for deterministic in (False, True):
+            actions, _ = model.predict(observation, deterministic=deterministic)
+            assert observation["action_mask"][np.arange(len(actions)), actions].all()
+        observation, *_ = env.step(actions)
+    model.learn(200)  # trains through the masked target without error
+
+
+def test_mixed_vec_env_joins_families_of_different_sizes() -> None:
+    from frontier_marl.training.batched_vec_env import MixedVecEnv, make_batched_vec_env
+
+    parts = [
+        make_batched_vec_env({"config": make_config(preset, **EXPLORER)}, 2, seed=0)
+        for preset in ("thesis-20x20", "rooms-32")
+    ]
+    mixed = MixedVecEnv(parts)
+    observation = mixed.reset()
+    assert mixed.num_envs == 4 and observation["slots"].shape[0] == 4
+    observation, rewards, dones, infos = mixed.step(mixed.action_masks().argmax(axis=1))
+    assert rewards.shape == (4,) and len(infos) == 4
+    with pytest.raises(ValueError, match="same observation space"):
+        MixedVecEnv([parts[0], make_batched_vec_env({"config": make_config()}, 1)])
