@@ -14,6 +14,7 @@ from frontier_marl.evaluation.heuristics import (
     FirstSlot,
     GreedyDistance,
     GreedyGain,
+    NearestPath,
     RandomValid,
 )
 from frontier_marl.evaluation.policies import CallablePolicy, HeuristicPolicy, ModelPolicy, Policy
@@ -41,6 +42,7 @@ __all__ = [
     "GreedyGain",
     "HeuristicPolicy",
     "ModelPolicy",
+    "NearestPath",
     "Policy",
     "RandomValid",
     "TeamHeuristic",
