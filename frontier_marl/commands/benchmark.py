@@ -3,7 +3,7 @@
 Examples::
 
     frontier-marl benchmark                                  # 4 families, every heuristic
-    frontier-marl benchmark --families random-20 --episodes 10 --policies nearest-path,thesis-config01
+    frontier-marl benchmark --families random-20 --policies nearest-path,thesis-config01
     frontier-marl benchmark --map ../shared/maps/explore-bench --json eb.json --plot eb.png
     frontier-marl benchmark --agents 3 --set cells_per_step=full
 

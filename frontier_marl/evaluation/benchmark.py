@@ -87,39 +87,19 @@ class MapFamily:
 
 
 def _family(name: str, description: str, **env: Any) -> MapFamily:
-    return MapFamily(name, tuple(env.items()), description)
+    return MapFamily(name, (*env.items(), ("map_mode", "dynamic")), description)
 
 
 #: The built-in families: the thesis's two random geometries (dynamic, 10 % obstacles on
 #: average: each layout's density drawn from U(0, 0.3)) and rooms and corridors at two sizes.
+_ROOMS_64 = {"height": 64, "width": 64, "perception_range": 5}
 FAMILIES: dict[str, MapFamily] = {
     f.name: f
     for f in (
-        _family(
-            "random-20",
-            "20x20 random obstacles (10 % on average), r = 3",
-            preset="thesis-20x20",
-            map_mode="dynamic",
-        ),
-        _family(
-            "random-30",
-            "30x30 random obstacles (10 % on average), r = 5",
-            preset="thesis-30x30",
-            map_mode="dynamic",
-        ),
-        _family(
-            "rooms-32", "32x32 rooms and corridors, r = 3", preset="rooms-32", map_mode="dynamic"
-        ),
-        _family(
-            "rooms-64",
-            "64x64 rooms and corridors, r = 5",
-            preset="rooms-32",
-            height=64,
-            width=64,
-            perception_range=5,
-            max_cluster_cells=12,
-            map_mode="dynamic",
-        ),
+        _family("random-20", "20x20 random obstacles, r = 3", preset="thesis-20x20"),
+        _family("random-30", "30x30 random obstacles, r = 5", preset="thesis-30x30"),
+        _family("rooms-32", "32x32 rooms and corridors, r = 3", preset="rooms-32"),
+        _family("rooms-64", "64x64 rooms and corridors, r = 5", preset="rooms-32", **_ROOMS_64),
     )
 }
 
@@ -387,9 +367,7 @@ def run_benchmark(
             for contender in policies:
                 bar.set_description(f"{fam.name} {contender.name}")
                 try:
-                    result = run_family(
-                        fam, contender, configs, episodes, lambda _r: bar.update(1)
-                    )
+                    result = run_family(fam, contender, configs, episodes, lambda _r: bar.update(1))
                 except ModelEnvMismatchError as exc:
                     if contender.heuristic:
                         raise

@@ -58,9 +58,11 @@ def paired_difference(
     if len(diffs) > 1:
         from scipy.stats import t
 
-        half = float(t.ppf(0.5 + confidence / 2, len(diffs) - 1)) * float(
-            diffs.std(ddof=1)
-        ) / math.sqrt(len(diffs))
+        half = (
+            float(t.ppf(0.5 + confidence / 2, len(diffs) - 1))
+            * float(diffs.std(ddof=1))
+            / math.sqrt(len(diffs))
+        )
         out["ci_low"], out["ci_high"] = mean - half, mean + half
     return out
 
