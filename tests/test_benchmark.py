@@ -155,6 +155,7 @@ def test_families_and_seed_ranges():
     assert (cfg.perception_range, cfg.max_cluster_cells, cfg.n_agents) == (4, 10, 2)
     assert cfg.n_slots == bench.HEURISTIC_SLOTS
     assert (cfg.reward.explore_threshold, cfg.reward.max_steps) == (0.99, 2 * 64 * 64)
+    assert (bench.default_commit(1), bench.default_commit(3)) == ("until-progress", "none")
     with pytest.raises(ValueError, match="unknown family"):
         bench.family("mazes")
     with pytest.raises(ValueError, match="episodes"):

@@ -64,9 +64,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--commit",
-        choices=["until-progress", "none"],
-        default="until-progress",
-        help="the heuristics' commit rule (default: %(default)s, which prevents livelocks)",
+        choices=["auto", "until-progress", "none"],
+        default="auto",
+        help="the heuristics' commit rule; auto (the default): until-progress with one robot "
+        "(it prevents livelocks), none with a team (docs/benchmark.md)",
     )
     parser.add_argument(
         "--set",
@@ -108,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
             policy_names = list(HEURISTICS) + (list(TEAM_HEURISTICS) if args.agents > 1 else [])
         if not policy_names:
             raise ValueError("--policies must name at least one policy")
-        policies = bench.contenders(policy_names, args.commit)
+        commit = bench.default_commit(args.agents) if args.commit == "auto" else args.commit
+        policies = bench.contenders(policy_names, commit)
         for fam in families:
             fam.seeds(args.episodes)
             bench.variant_configs(fam, overrides, args.agents)
@@ -145,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
             "policies": policy_names,
             "episodes": args.episodes,
             "agents": args.agents,
-            "commit": args.commit,
+            "commit": commit,
             "set": list(args.overrides),
         }
         write_json({"options": options, "wall_seconds": wall, "rows": rows}, args.json)

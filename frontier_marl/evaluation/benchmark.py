@@ -11,10 +11,12 @@ generous limit scaled to the map; ``cells_per_step`` (how far one decision moves
 the family's, for every policy alike.
 
 Heuristics see every reachable cluster (``n_slots`` = :data:`HEURISTIC_SLOTS`, the most the env
-allows; decisions where all slots were full are counted in ``saturated_decisions``) and use the
-``commit="until-progress"`` rule that prevents livelocks. A learned model keeps its own
-observation settings (:data:`OBSERVATION_KEYS`, from its saved metadata) and takes everything
-else (map, sensor, movement, episode end) from the family.
+allows; decisions where all slots were full are counted in ``saturated_decisions``). Their
+``commit`` rule is :func:`default_commit`'s: ``until-progress`` for one robot (it prevents the
+livelocks of re-deciding every cell), ``none`` for teams (a blocked robot that keeps its target
+can deadlock head-on with a teammate in a corridor while nothing new is seen). A learned model
+keeps its own observation settings (:data:`OBSERVATION_KEYS`, from its saved metadata) and takes
+everything else (map, sensor, movement, episode end) from the family.
 
 Statistics (T99, T90, success, the paired difference to the best heuristic) are in
 :mod:`frontier_marl.evaluation.benchmark_stats`.
@@ -216,6 +218,11 @@ class Contender:
     heuristic: bool
     make: Callable[[], Any]
     config: Callable[[EnvConfig], EnvConfig]
+
+
+def default_commit(agents: int) -> str:
+    """The heuristics' commit rule in the benchmark (see the module docstring)."""
+    return "until-progress" if agents == 1 else "none"
 
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
