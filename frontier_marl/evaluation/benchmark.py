@@ -305,9 +305,12 @@ def run_family(
 ) -> EvaluationResult:
     """``episodes`` held-out episodes of one policy on one family (``worlds`` from
     :func:`variant_configs`); the result's ``extra`` holds the family, maps and seeds."""
+    import time
+
     from frontier_marl.envs.parallel import FrontierParallelEnv
     from frontier_marl.evaluation.protocol import evaluate
 
+    start = time.perf_counter()
     seeds = fam.seeds(episodes)
     configs = [contender.config(world) for world in worlds]
     envs = [FrontierParallelEnv(config=cfg) for cfg in configs]
@@ -341,6 +344,7 @@ def run_family(
         maps=[Path(m).name for m in fam.maps],
         episode_maps=[None if m is None else Path(m).name for m in maps],
         saturated_decisions=policy.saturated,
+        wall_seconds=time.perf_counter() - start,
     )
     return result
 

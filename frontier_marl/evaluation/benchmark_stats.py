@@ -83,7 +83,7 @@ def _stats(values: Sequence[float | None]) -> tuple[float | None, float | None]:
 
 def summary_row(result: EvaluationResult) -> dict[str, Any]:
     """One benchmark row (the fields of the module docstring, without the comparison) plus
-    the per-episode records (without their per-step curves)."""
+    the per-episode records (without their per-step curves and action counts)."""
     t99 = _level(result, 0.99)
     t90 = _level(result, 0.90)
     team = result.n_agents > 1
@@ -99,6 +99,7 @@ def summary_row(result: EvaluationResult) -> dict[str, Any]:
     per_episode = []
     for record, name in zip(result.episodes, episode_maps, strict=True):
         entry = record.to_dict(curve=False)
+        del entry["action_counts"]  # one count per slot: 256 numbers for a heuristic
         entry["t99"] = record.cells_to_coverage.get(level_key(0.99))
         entry["t90"] = record.cells_to_coverage.get(level_key(0.90))
         if name is not None:
