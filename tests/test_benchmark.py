@@ -244,6 +244,8 @@ def test_cli_team_adds_makespan_and_overlap(tmp_path, capsys):
     [
         (["--families", "mazes"], "unknown family 'mazes'"),
         (["--policies", "greedy-nowhere"], "unknown policy 'greedy-nowhere'"),
+        (["--policies", __file__], "cannot load model"),
+        (["--episodes", "100001"], "episodes must be in [1, 100000]"),
         (["--map", "/nonexistent/map.pgm"], "does not exist"),
         (["--set", "n_agents=3"], "n_agents"),
         (["--set", "perception_range=0"], "perception_range"),

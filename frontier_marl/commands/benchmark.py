@@ -82,6 +82,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--plot", type=Path, default=None, metavar="FILE", help="write a PNG of T99 per family"
     )
+    parser.add_argument("--markdown", action="store_true", help="print the table as Markdown")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
@@ -134,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
         + (f", {' '.join(args.overrides)}" if args.overrides else "")
     )
     print(title)
-    print(format_table(rows))
+    print(format_table(rows, markdown=args.markdown))
     print(
         "T99/T90: cells travelled to 99 %/90 % coverage, mean ± std over the episodes that got "
         "there (* = not all did); vs best: paired per-episode relative difference to the "

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, ObservationConfig, config_to_dict, make_config
+from frontier_marl.evaluation.policies import Policy
 from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
 
 #: Held-out episode seeds of every family (episode i: seed 900_000 + i); never used for
@@ -226,10 +227,9 @@ def default_commit(agents: int) -> str:
 
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
-    from frontier_marl.evaluation.registry import POLICIES, make_policy
+    """A heuristic of the registry, with ``commit`` (``random`` has no commit rule)."""
+    from frontier_marl.evaluation.registry import make_policy
 
-    if name not in POLICIES:
-        raise ValueError(name)
     options = {} if name == "random" else {"commit": commit}
     return Contender(name, True, lambda: make_policy(name, 0, **options), lambda cfg: cfg)
 
@@ -239,7 +239,10 @@ def model(name: str) -> Contender:
     from frontier_marl.evaluation.policies import ModelPolicy
     from frontier_marl.training.evaluate_model import check_model_env, load_model
 
-    loaded = load_model(name)
+    try:
+        loaded = load_model(name)
+    except Exception as exc:  # e.g. a file that is not an SB3 zip
+        raise ValueError(f"cannot load model {name}: {exc}") from exc
     if loaded.metadata is None:
         raise ValueError(f"model {name}: no metadata saved beside it (its observation settings)")
     saved = config_to_dict(loaded.env_config())
@@ -273,13 +276,14 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
     return out
 
 
-class _SlotWatch:
+class _SlotWatch(Policy):
     """Counts decisions where every slot held a cluster (some clusters may have gone
     unoffered); delegates everything else to the wrapped policy."""
 
-    def __init__(self, policy: Any) -> None:
+    def __init__(self, policy: Policy) -> None:
         self.policy = policy
-        self.name = getattr(policy, "name", "policy")
+        self.name = policy.name
+        self.deterministic = policy.deterministic
         self.saturated = 0
 
     def reset(self, seed: int | None = None) -> None:
@@ -320,7 +324,7 @@ def run_family(
     try:
         for i, seed in enumerate(seeds):
             env = envs[i % len(envs)]
-            record = evaluate(env, policy, episodes=1, seed=seed).episodes[0]  # type: ignore[arg-type]
+            record = evaluate(env, policy, episodes=1, seed=seed).episodes[0]
             records.append(record)
             maps.append(configs[i % len(envs)].map_path)
             if on_episode is not None:
