@@ -188,13 +188,13 @@ def variant_configs(
 
             height, width = load_map(path).shape
             kwargs.update(map_path=path, perception_range=loaded_map_range(height, width))
-        base = make_config(**kwargs)
-        kwargs.update(episode_settings(base.height, base.width))
-        kwargs.update(n_slots=HEURISTIC_SLOTS, n_agents=agents)
-        kwargs.update(overrides)
-        if "perception_range" in kwargs and "max_cluster_cells" not in overrides:
-            kwargs["max_cluster_cells"] = 2 * int(kwargs["perception_range"]) + 2
+        kwargs.update(n_slots=HEURISTIC_SLOTS, n_agents=agents, **overrides)
         try:
+            shape = make_config(**kwargs).shape  # the size after the overrides
+            kwargs.update({**episode_settings(*shape), **overrides})
+            r = kwargs.get("perception_range")
+            if isinstance(r, int) and "max_cluster_cells" not in overrides:
+                kwargs["max_cluster_cells"] = 2 * r + 2
             out.append(make_config(**kwargs))
         except ValueError as exc:
             raise ValueError(f"family {fam.name}: {exc}") from None
