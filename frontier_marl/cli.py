@@ -13,6 +13,10 @@ from collections.abc import Sequence
 COMMANDS: dict[str, tuple[str, str]] = {
     "gif": ("gif", "run one episode with a heuristic and write it as a GIF"),
     "baselines": ("baselines", "evaluate the heuristic baselines with the thesis's protocol"),
+    "benchmark": (
+        "benchmark",
+        "exploration efficiency (T99, T90, success) of policies on map families",
+    ),
     "train": ("train", "train DQN on an experiment config (SB3 through SuperSuit)"),
     "evaluate": ("evaluate", "evaluate a trained model with the thesis's protocol"),
     "reproduce": (

@@ -6,7 +6,10 @@
 * :mod:`~frontier_marl.evaluation.policies`: the :class:`Policy` interface and model adapters;
   :mod:`~frontier_marl.evaluation.heuristics` and :mod:`~frontier_marl.evaluation.team`: the
   heuristics, by name in :mod:`~frontier_marl.evaluation.registry`;
-* :mod:`~frontier_marl.evaluation.plots`: result figures.
+* :mod:`~frontier_marl.evaluation.plots`: result figures;
+* :mod:`~frontier_marl.evaluation.benchmark` and
+  :mod:`~frontier_marl.evaluation.benchmark_stats`: the exploration benchmark (map families,
+  T99/T90, the paired difference to the best heuristic; docs/benchmark.md).
 """
 
 from frontier_marl.evaluation.heuristics import (
@@ -14,6 +17,7 @@ from frontier_marl.evaluation.heuristics import (
     FirstSlot,
     GreedyDistance,
     GreedyGain,
+    NearestPath,
     RandomValid,
 )
 from frontier_marl.evaluation.policies import CallablePolicy, HeuristicPolicy, ModelPolicy, Policy
@@ -41,6 +45,7 @@ __all__ = [
     "GreedyGain",
     "HeuristicPolicy",
     "ModelPolicy",
+    "NearestPath",
     "Policy",
     "RandomValid",
     "TeamHeuristic",

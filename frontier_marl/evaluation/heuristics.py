@@ -8,6 +8,10 @@ state:
 * ``greedy-distance``: the nearest cluster (smallest Euclidean centroid ``distance``; ties:
   lowest slot).
 * ``greedy-gain``: the largest information ``gain`` (ties: nearest, then lowest slot).
+* ``nearest-path``: the nearest cluster by known-free path (Yamauchi 1997's nearest frontier):
+  the smallest ``path_length``, the 4-connected shortest path from the robot to the cluster's
+  target through known-free cells (what A* walks), not the Euclidean distance to the
+  centroid. Ties: nearest centroid, then lowest slot.
 * ``cost-utility``: the largest ``gain / path length``, the path length being the 4-connected
   shortest path (what A* returns) from the robot to the cluster's target over the known-free
   cells of the belief (a length of 0 counts as 1). Ties: nearest, then lowest slot.
@@ -64,6 +68,20 @@ class FirstSlot(HeuristicPolicy):
 
     def choose(self, info: Info) -> int:
         return 0
+
+
+class NearestPath(HeuristicPolicy):
+    """Nearest cluster by known-free path length (Yamauchi's nearest frontier); ties go to the
+    nearest centroid, then the lowest slot."""
+
+    name = "nearest-path"
+
+    def choose(self, info: Info) -> int:
+        table = slot_table(info)
+        if not table.live:
+            return 0
+        live = table.live
+        return first_by(table.path_length[:live], table.distance[:live])
 
 
 class CostUtility(HeuristicPolicy):

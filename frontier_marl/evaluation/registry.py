@@ -10,6 +10,7 @@ from frontier_marl.evaluation.heuristics import (
     FirstSlot,
     GreedyDistance,
     GreedyGain,
+    NearestPath,
     RandomValid,
 )
 from frontier_marl.evaluation.policies import Policy
@@ -20,6 +21,7 @@ POLICIES: dict[str, type[Policy]] = {
     "greedy-distance": GreedyDistance,
     "greedy-gain": GreedyGain,
     "cost-utility": CostUtility,
+    "nearest-path": NearestPath,
     "random": RandomValid,
     "first-slot": FirstSlot,
     "coordinated-assignment": CoordinatedAssignment,

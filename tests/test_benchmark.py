@@ -1,0 +1,298 @@
+"""The benchmark: the nearest-path heuristic, the paired difference, same episodes for every
+policy, the families, and the ``frontier-marl benchmark`` command."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import frontier_marl
+from frontier_marl.cli import main
+from frontier_marl.core.frontiers import cluster_frontiers
+from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
+from frontier_marl.core.slots import robot_slots
+from frontier_marl.evaluation import GreedyDistance, NearestPath, make_policy
+from frontier_marl.evaluation import benchmark as bench
+from frontier_marl.evaluation.benchmark_stats import (
+    best_heuristic,
+    compare,
+    format_table,
+    paired_difference,
+)
+
+EXPLORE_BENCH = Path(__file__).resolve().parents[2] / "shared" / "maps" / "explore-bench"
+_CODES = {"?": UNKNOWN, ".": FREE, "#": OCCUPIED, "R": FREE}
+
+# ----------------------------------------------------------------- nearest-path
+
+# A non-square 6x7 belief. The robot R stands at (1, 1). Cluster A, (0, 3) and (1, 3), is
+# behind a wall: its centroid (0.5, 3) is 2.06 away in a straight line but its target (0, 3)
+# is 7 cells away by the known-free path (down, right, up). Cluster B, (4, 1), is 3 away both
+# ways. Greedy distance takes A; nearest-path takes B.
+WALLED = """
+# . # . ? ? ?
+# R # . ? ? ?
+# . # . # # ?
+# . . . # # ?
+# . # # # # ?
+# ? # # # # ?
+"""
+
+
+def walled_info() -> dict:
+    rows = [line.split() for line in WALLED.strip().splitlines()]
+    belief = np.array([[_CODES[c] for c in row] for row in rows], dtype=np.int8)
+    clusters = cluster_frontiers(belief, connectivity=8, max_cells=8)
+    table = robot_slots(belief, (1, 1), clusters, clusters.sizes.astype(float), 4, False)
+    return {"slots": table, "action_mask": table.mask, "new_cells": 1}
+
+
+def test_nearest_path_takes_the_shortest_known_free_path_not_the_nearest_centroid():
+    info = walled_info()
+    table = info["slots"]
+    assert table.live == 2
+    by_target = {tuple(table.target[s]): s for s in range(table.live)}
+    a, b = by_target[(0, 3)], by_target[(4, 1)]
+    assert table.path_length[a] == 7 and table.path_length[b] == 3
+    assert table.distance[a] < table.distance[b]  # A is the nearer centroid
+    assert GreedyDistance().act(None, info) == a
+    assert NearestPath().act(None, info) == b
+    assert make_policy("nearest-path").act(None, info) == b
+
+
+def test_nearest_path_ties_go_to_the_nearest_centroid():
+    from tests.helpers import info_with, live_slot
+
+    info = info_with([live_slot(1, 4.0, path_length=5), live_slot(1, 3.0, path_length=5)])
+    assert NearestPath().act(None, info) == 1
+
+
+# ----------------------------------------------------------------- statistics
+
+
+def test_paired_difference_on_hand_computed_numbers():
+    # relative differences 0.1, -0.1, 0.2: mean 1/15, sample std sqrt(0.07/3) = 0.152753;
+    # t(0.975, 2 dof) = 4.302653 -> half-width 4.302653 * 0.152753 / sqrt(3) = 0.379454
+    out = paired_difference([110, 90, 120, None], [100, 100, 100, 100])
+    assert out["pairs"] == 3
+    assert out["mean"] == pytest.approx(1 / 15)
+    half = 4.302653 * math.sqrt(0.07 / 3) / math.sqrt(3)
+    assert out["ci_low"] == pytest.approx(1 / 15 - half, abs=1e-5)
+    assert out["ci_high"] == pytest.approx(1 / 15 + half, abs=1e-5)
+    assert paired_difference([5], [4]) == {
+        "pairs": 1,
+        "mean": 0.25,
+        "ci_low": None,
+        "ci_high": None,
+    }
+    assert paired_difference([None], [4])["mean"] is None
+    with pytest.raises(ValueError, match="pair up"):
+        paired_difference([1, 2], [1])
+
+
+def _row(policy, t99, heuristic=True):
+    success = sum(v is not None for v in t99)
+    reached = [v for v in t99 if v is not None]
+    return {
+        "policy": policy,
+        "family": "f",
+        "agents": 1,
+        "episodes": len(t99),
+        "heuristic": heuristic,
+        "success": success,
+        "t99_mean": float(np.mean(reached)) if reached else None,
+        "t99_std": float(np.std(reached)) if reached else None,
+        "t99_partial": success < len(t99),
+        "t90_mean": None,
+        "t90_std": None,
+        "per_episode": [{"t99": v} for v in t99],
+    }
+
+
+def test_best_heuristic_has_most_successes_then_lowest_t99():
+    rows = [
+        _row("a", [100, 110]),
+        _row("b", [80, None]),  # lower mean, but a failure
+        _row("c", [105, 100]),
+        _row("model", [50, 50], heuristic=False),  # models are never the reference
+    ]
+    assert best_heuristic(rows)["policy"] == "c"
+    compare(rows)
+    assert {r["best_heuristic"] for r in rows} == {"c"}
+    assert rows[2]["vs_best"]["mean"] == 0.0
+    assert rows[1]["vs_best"]["pairs"] == 1
+    assert rows[3]["vs_best"]["mean"] == pytest.approx(((50 - 105) / 105 + (50 - 100) / 100) / 2)
+    table = format_table(rows)
+    assert "80.0 ± 0.0*" in table and "best" in table
+
+
+# ----------------------------------------------------------------- families and episodes
+
+
+def test_families_and_seed_ranges():
+    assert list(bench.FAMILIES) == ["random-20", "random-30", "rooms-32", "rooms-64"]
+    for fam in bench.FAMILIES.values():
+        held = set(fam.heldout)
+        assert not held & set(fam.train[-1000:]) and not held & set(fam.validation)
+        assert fam.train.stop <= fam.validation.start and fam.validation.stop <= fam.heldout.start
+        assert fam.seeds(3) == [900_000, 900_001, 900_002]
+    shapes = {
+        name: (c.height, c.width, c.perception_range, c.map_generator, c.map_mode)
+        for name in bench.FAMILIES
+        for c in bench.variant_configs(bench.family(name))
+    }
+    assert shapes == {
+        "random-20": (20, 20, 3, "random", "dynamic"),
+        "random-30": (30, 30, 5, "random", "dynamic"),
+        "rooms-32": (32, 32, 3, "rooms", "dynamic"),
+        "rooms-64": (64, 64, 5, "rooms", "dynamic"),
+    }
+    (cfg,) = bench.variant_configs(bench.family("rooms-64"), {"perception_range": 4}, agents=2)
+    assert (cfg.perception_range, cfg.max_cluster_cells, cfg.n_agents) == (4, 10, 2)
+    assert cfg.n_slots == bench.HEURISTIC_SLOTS
+    assert (cfg.reward.explore_threshold, cfg.reward.max_steps) == (0.99, 2 * 64 * 64)
+    assert (bench.default_commit(1), bench.default_commit(3)) == ("until-progress", "none")
+    with pytest.raises(ValueError, match="unknown family"):
+        bench.family("mazes")
+    with pytest.raises(ValueError, match="episodes"):
+        bench.family("random-20").seeds(0)
+
+
+@pytest.mark.parametrize("name", ["random-20", "rooms-32"])
+def test_same_maps_and_starts_whatever_the_observation_settings(name):
+    """The reset seed alone fixes the true grid and the start cells."""
+    (world,) = bench.variant_configs(bench.family(name), agents=2)
+    variants = [
+        {},
+        {"n_slots": 4, "centroid": "relative", "sort_by_distance": True},
+        {"n_slots": 8, "centroid": "none", "info_gain": True, "agent_position": False},
+        {"normalize": True, "teammates": "positions", "action_mask": True, "gain": "unknown"},
+    ]
+    envs = [frontier_marl.parallel_env(config=world.replace(**v)) for v in variants]
+    for seed in bench.family(name).seeds(3):
+        grids, starts = [], []
+        for env in envs:
+            env.reset(seed=seed)
+            grids.append(np.array(env.world.true_grid))
+            starts.append(np.array(env.world.positions))
+        for grid, start in zip(grids[1:], starts[1:], strict=True):
+            np.testing.assert_array_equal(grid, grids[0])
+            np.testing.assert_array_equal(start, starts[0])
+    assert not np.array_equal(grids[0], np.zeros_like(grids[0]))
+
+
+def test_loaded_maps_cycle_and_scale_the_sensor(tmp_path):
+    small = tmp_path / "small.txt"
+    small.write_text("\n".join(["." * 9] * 6) + "\n")
+    fam = bench.map_family([tmp_path])
+    assert fam.name == f"map:{tmp_path.name}" and fam.maps == (str(small),)
+    (cfg,) = bench.variant_configs(fam)
+    assert (cfg.height, cfg.width, cfg.perception_range, cfg.map_mode) == (6, 9, 3, "static")
+    assert bench.loaded_map_range(250, 250) == 35
+    with pytest.raises(ValueError, match="does not exist"):
+        bench.map_family([tmp_path / "nothing.pgm"])
+
+
+# ----------------------------------------------------------------- the command
+
+
+def test_cli_smoke_with_a_family_and_a_loaded_map(tmp_path, capsys):
+    out_json, out_png = tmp_path / "b.json", tmp_path / "b.png"
+    argv = ["benchmark", "--families", "random-20", "--map", "rooms-32", "--episodes", "2"]
+    argv += ["--json", str(out_json), "--plot", str(out_png), "--no-progress"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "nearest-path" in text and "map:rooms-32" in text and "best" in text
+    data = json.loads(out_json.read_text())
+    rows = data["rows"]
+    assert len(rows) == 8  # 2 families x 4 heuristics
+    keys = ("policy", "family", "agents", "episodes", "success", "t99_mean", "t99_std")
+    for row in rows:
+        for key in (*keys, "t90_mean", "makespan99_mean", "per_episode"):
+            assert key in row
+        assert row["success"] == 2 and row["episodes"] == 2 and row["agents"] == 1
+        assert [e["seed"] for e in row["per_episode"]] == [900_000, 900_001]
+        assert row["makespan99_mean"] == row["t99_mean"]  # one robot
+    by_family = {}
+    for row in rows:
+        by_family.setdefault(row["family"], []).append(row)
+    for family_rows in by_family.values():  # same episodes: same seeds, same first coverage
+        starts = {tuple(e["seed"] for e in r["per_episode"]) for r in family_rows}
+        assert len(starts) == 1
+    assert out_png.stat().st_size > 0
+
+
+def test_cli_team_adds_makespan_and_overlap(tmp_path, capsys):
+    argv = ["benchmark", "--families", "random-20", "--episodes", "2", "--agents", "2"]
+    argv += ["--policies", "nearest-path,coordinated-assignment", "--no-progress"]
+    argv += ["--json", str(tmp_path / "t.json"), "--set", "perception_range=2"]
+    assert main(argv) == 0
+    assert "makespan" in capsys.readouterr().out
+    rows = json.loads((tmp_path / "t.json").read_text())["rows"]
+    for row in rows:
+        assert row["agents"] == 2 and row["config"]["perception_range"] == 2
+        assert row["makespan99_mean"] < row["t99_mean"]
+        assert row["overlap_mean"] >= 0
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--families", "mazes"], "unknown family 'mazes'"),
+        (["--policies", "greedy-nowhere"], "unknown policy 'greedy-nowhere'"),
+        (["--policies", __file__], "cannot load model"),
+        (["--episodes", "100001"], "episodes must be in [1, 100000]"),
+        (["--map", "/nonexistent/map.pgm"], "does not exist"),
+        (["--set", "n_agents=3"], "n_agents"),
+        (["--set", "perception_range=0"], "perception_range"),
+        (["--families", ","], "at least one family"),
+    ],
+)
+def test_cli_bad_input(argv, message, capsys):
+    assert main(["benchmark", "--no-progress", *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("agents", ["0", "-1"])
+def test_cli_agents_must_be_positive(agents, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark", "--agents", agents])
+    assert exc.value.code == 2
+    assert "expected an integer >= 1" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not EXPLORE_BENCH.is_dir(), reason=f"{EXPLORE_BENCH} is absent")
+def test_cli_explore_bench_folder(tmp_path):
+    out = tmp_path / "eb.json"
+    argv = ["benchmark", "--map", str(EXPLORE_BENCH), "--episodes", "2", "--no-progress"]
+    argv += ["--policies", "nearest-path", "--json", str(out)]
+    assert main(argv) == 0
+    (row,) = json.loads(out.read_text())["rows"]
+    assert row["family"] == "map:explore-bench" and len(row["maps"]) == 12
+    assert [e["map"] for e in row["per_episode"]] == row["maps"][:2]
+    assert row["config"]["perception_range"] == 35 and row["success"] == 2
+
+
+def test_cli_shipped_model_keeps_its_observation_settings(tmp_path, capsys):
+    pytest.importorskip("stable_baselines3")
+    out = tmp_path / "m.json"
+    argv = ["benchmark", "--families", "random-20,random-30", "--episodes", "1"]
+    argv += ["--policies", "nearest-path,thesis-config01", "--json", str(out), "--no-progress"]
+    assert main(argv) == 0
+    assert "thesis-config01 skipped on random-30" in capsys.readouterr().err  # a 20x20 model
+    rows = json.loads(out.read_text())["rows"]
+    assert [(r["family"], r["policy"]) for r in rows] == [
+        ("random-20", "nearest-path"),
+        ("random-20", "thesis-config01"),
+        ("random-30", "nearest-path"),
+    ]
+    heuristic, model = rows[0], rows[1]
+    assert (heuristic["n_slots"], model["n_slots"]) == (bench.HEURISTIC_SLOTS, 4)
+    assert model["config"]["normalize"] and not heuristic["config"]["normalize"]
+    for key in ("perception_range", "cells_per_step", "max_steps", "explore_threshold"):
+        assert model["config"][key] == heuristic["config"][key]
+    assert model["best_heuristic"] == "nearest-path" and not model["heuristic"]
