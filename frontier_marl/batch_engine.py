@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import commit_to_previous
 from frontier_marl.core.worlds import SlotArrays, Worlds
 from frontier_marl.episodes import EpisodeSource, world_params
 from frontier_marl.observations import ObservationEncoder, teammate_rows
@@ -96,6 +97,10 @@ class BatchMDP:
         self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + 1)
         indices = self._all[active]
         worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
+        if self.cfg.observation.commit == "until-progress":
+            slots.mask[:] = commit_to_previous(
+                slots.mask, slots.target, slots.valid, targets, new_cells > 0
+            )
         reward = self.cfg.reward
         fraction = worlds.explored_fraction(reward.threshold_basis)
         outcome = batch_outcome(

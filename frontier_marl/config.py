@@ -35,6 +35,7 @@ ThresholdBasis = Literal["all", "free", "reachable"]
 RewardKind = Literal["reward1", "reward2", "travel"]
 TeammateEncoding = Literal["none", "positions", "positions+targets"]
 FeatureLayout = Literal["thesis", "explorer"]
+CommitRule = Literal["none", "until-progress"]
 FULL_PATH = "full"
 
 _CENTROIDS = ("absolute", "relative", "distance", "none")
@@ -47,6 +48,7 @@ _BASES = ("all", "free", "reachable")
 _REWARDS = ("reward1", "reward2", "travel")
 _TEAMMATES = ("none", "positions", "positions+targets")
 _FEATURES = ("thesis", "explorer")
+_COMMITS = ("none", "until-progress")
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,10 @@ class ObservationConfig:
             features that do not depend on the map size (path length, gain, isolation, ...;
             :mod:`frontier_marl.slot_features`), a ``Dict`` of ``slots`` and ``action_mask``;
             the axes above are then unused.
+        commit: ``until-progress`` narrows a robot's action mask to the slot of its previous
+            target while its last step revealed no new cell and that target is still offered
+            (the heuristics' livelock rule, docs/calibration.md, for a learned policy); ``none``
+            (the default) leaves every live slot valid.
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -79,9 +85,11 @@ class ObservationConfig:
     normalize: bool = False
     teammates: TeammateEncoding = "none"
     features: FeatureLayout = "thesis"
+    commit: CommitRule = "none"
 
     def validate(self) -> None:
         check_choice("features", self.features, _FEATURES)
+        check_choice("commit", self.commit, _COMMITS)
         check_choice("centroid", self.centroid, _CENTROIDS)
         check_choice("teammates", self.teammates, _TEAMMATES)
         for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):

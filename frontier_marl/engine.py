@@ -17,12 +17,12 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import SlotTable
+from frontier_marl.core.slots import SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
 from frontier_marl.core.worlds import SlotArrays
 from frontier_marl.episodes import EpisodeSource, world_params
 from frontier_marl.observations import ObservationEncoder, teammate_rows
-from frontier_marl.rewards import OscillationHistory, StepEvents, StepOutcome, step_outcome
+from frontier_marl.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
 
 Observation = np.ndarray | dict[str, np.ndarray]
 
@@ -66,6 +66,7 @@ class ExplorationMDP:
         self.source = EpisodeSource(cfg)
         self.world: World | None = None
         self._slots: list[SlotTable] = []
+        self._slot_arrays: SlotArrays | None = None
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
@@ -106,21 +107,29 @@ class ExplorationMDP:
         before = world.travelled.copy()
         moved = world.move(targets)
         self.steps += 1
-        new_cells = moved.new_cells.tolist()
-        self.steps_without_progress = 0 if any(new_cells) else self.steps_without_progress + 1
+        new_cells = moved.new_cells
+        self.steps_without_progress = 0 if new_cells.any() else self.steps_without_progress + 1
         self._refresh_slots()
+        assert self._slot_arrays is not None
+        if cfg.observation.commit == "until-progress":
+            arrays = self._slot_arrays
+            arrays.mask[:] = commit_to_previous(
+                arrays.mask, arrays.target, arrays.valid, targets, new_cells > 0
+            )
         fraction = world.explored_fraction(cfg.reward.threshold_basis)
-        events = StepEvents(
-            new_cells=new_cells,
-            padding=padding,
-            oscillation=oscillation,
-            threshold_reached=fraction >= cfg.reward.explore_threshold,
-            no_frontier_left=not any(table.live for table in self._slots),
-            steps_taken=self.steps,
-            steps_without_progress=self.steps_without_progress,
-            moved=world.travelled - before,
+        outcome = first_outcome(
+            batch_outcome(
+                cfg.reward,
+                new_cells[None],
+                padding[None],
+                oscillation[None],
+                np.array([fraction >= cfg.reward.explore_threshold]),
+                np.array([not self._slot_arrays.live.any()]),
+                np.array([self.steps]),
+                np.array([self.steps_without_progress]),
+                (world.travelled - before)[None],
+            )
         )
-        outcome = step_outcome(cfg.reward, events)
         self.done = outcome.terminated or outcome.truncated
         self.last = StepResult(
             self._observations(targets, moved.reached),
@@ -159,9 +168,8 @@ class ExplorationMDP:
     def _refresh_slots(self) -> None:
         assert self.world is not None
         sort = self.cfg.observation.sort_by_distance
-        self._slots = [
-            self.world.slots(agent, self.cfg.n_slots, sort) for agent in range(self.cfg.n_agents)
-        ]
+        self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        self._slots = [self._slot_arrays.table(agent) for agent in range(self.cfg.n_agents)]
 
     def slot_tables(self) -> list[SlotTable]:
         """The slot tables the robots observe now (the ones their next actions refer to)."""
@@ -181,7 +189,7 @@ class ExplorationMDP:
         heading = self._heading(targets, reached)
         mates = self._teammate_table(positions, heading)
         batch = self.encoder.encode_batch(
-            SlotArrays.stack(self._slots),
+            self._slot_arrays,
             positions,
             None if mates is None else teammate_rows(mates),
             heading,

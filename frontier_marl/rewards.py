@@ -26,12 +26,14 @@ penalty. The episode also terminates when no robot has a reachable frontier left
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from frontier_marl.config import RewardConfig
+from frontier_marl.core.compiled import compiled
 
 
 class OscillationHistory:
@@ -52,18 +54,31 @@ class OscillationHistory:
 
     def update(self, targets: np.ndarray) -> np.ndarray:
         """Record ``targets`` (W, N, 2); returns bool (W, N): which robots oscillate."""
-        history = self._history
-        last = history[:, :, -1]
-        earlier = history[:, :, :-1]
-        oscillates = (
-            (targets[..., 0] >= 0)
-            & (last[..., 0] >= 0)
-            & (targets != last).any(axis=-1)
-            & (earlier == targets[:, :, None]).all(axis=-1).any(axis=-1)
-        )
-        history[:, :, :-1] = history[:, :, 1:]
-        history[:, :, -1] = targets
-        return oscillates
+        out = np.empty(targets.shape[:2], dtype=np.bool_)
+        _oscillation_update(self._history, np.asarray(targets, dtype=np.int64), out)
+        return out
+
+
+@compiled
+def _oscillation_update(history: np.ndarray, targets: np.ndarray, out: np.ndarray) -> None:
+    """:meth:`OscillationHistory.update` on its ``(W, N, window + 1, 2)`` history."""
+    depth = history.shape[2]
+    for w in range(targets.shape[0]):
+        for n in range(targets.shape[1]):
+            row, col = targets[w, n, 0], targets[w, n, 1]
+            last_row, last_col = history[w, n, depth - 1, 0], history[w, n, depth - 1, 1]
+            flag = False
+            if row >= 0 and last_row >= 0 and (row != last_row or col != last_col):
+                for i in range(depth - 1):
+                    if history[w, n, i, 0] == row and history[w, n, i, 1] == col:
+                        flag = True
+                        break
+            out[w, n] = flag
+            for i in range(depth - 1):
+                history[w, n, i, 0] = history[w, n, i + 1, 0]
+                history[w, n, i, 1] = history[w, n, i + 1, 1]
+            history[w, n, depth - 1, 0] = row
+            history[w, n, depth - 1, 1] = col
 
 
 class OscillationDetector:
@@ -137,35 +152,123 @@ def batch_outcome(
     """Apply the reward table to one step of W worlds of N robots: per-robot arrays are
     ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched);
     ``moved`` (cells walked) is needed by the ``travel`` reward only."""
-    weight = cfg.team_weight
-    if weight:
-        credited = (1.0 - weight) * new_cells + weight * new_cells.sum(axis=1, keepdims=True)
-    else:
-        credited = new_cells
-    rewards = cfg.cell_reward * credited
-    if cfg.kind == "travel":
-        if moved is None:
-            raise ValueError("the travel reward needs the cells each robot walked")
-        rewards = rewards + cfg.travel_cost * np.maximum(moved, 1)
-    else:
-        rewards = rewards + np.where(new_cells == 0, cfg.no_new_cell_penalty, 0.0)
-    rewards = rewards + np.where(padding, cfg.padding, 0.0)
-    if cfg.kind == "reward2":
-        rewards = rewards + np.where(oscillation, cfg.oscillation_penalty, 0.0)
-    threshold = np.asarray(threshold_reached, dtype=bool)
-    no_frontier = np.asarray(no_frontier_left, dtype=bool) & ~threshold
-    going_on = ~(threshold | no_frontier)
-    no_progress = going_on & (steps_without_progress >= cfg.no_progress_limit)
-    step_limit = going_on & (steps_taken >= cfg.max_steps)
-    reason = threshold * THRESHOLD + no_frontier * NO_FRONTIER
-    reason = reason + no_progress * NO_PROGRESS + step_limit * STEP_LIMIT
-    if cfg.padding_truncates:
-        reason = reason + (going_on & padding.any(axis=1)) * PADDING
-    rewards = rewards + np.where(threshold, cfg.goal_bonus, 0.0)[:, None]
-    rewards = rewards + np.where(no_progress, cfg.no_progress_penalty, 0.0)[:, None]
-    rewards = rewards + np.where(step_limit, cfg.step_limit_penalty, 0.0)[:, None]
-    truncated = going_on & (reason > 0)
-    return BatchOutcome(rewards, threshold | no_frontier, truncated, reason)
+    travel = cfg.kind == "travel"
+    if travel and moved is None:
+        raise ValueError("the travel reward needs the cells each robot walked")
+    worlds, robots = new_cells.shape
+    outcome = BatchOutcome(
+        np.empty((worlds, robots)),
+        np.empty(worlds, dtype=bool),
+        np.empty(worlds, dtype=bool),
+        np.empty(worlds, dtype=np.int64),
+    )
+    _reward_table(
+        _constants(cfg),
+        travel,
+        cfg.padding_truncates,
+        cfg.no_progress_limit,
+        cfg.max_steps,
+        np.asarray(new_cells, dtype=np.int64),
+        np.asarray(padding, dtype=np.bool_),
+        np.asarray(oscillation, dtype=np.bool_),
+        np.asarray(threshold_reached, dtype=np.bool_),
+        np.asarray(no_frontier_left, dtype=np.bool_),
+        np.asarray(steps_taken, dtype=np.int64),
+        np.asarray(steps_without_progress, dtype=np.int64),
+        np.zeros_like(new_cells, dtype=np.int64) if moved is None else moved.astype(np.int64),
+        outcome.rewards,
+        outcome.terminated,
+        outcome.truncated,
+        outcome.reason,
+    )
+    return outcome
+
+
+@functools.lru_cache(maxsize=64)
+def _constants(cfg: RewardConfig) -> np.ndarray:
+    """The reward table's constants, in :func:`_reward_table`'s order."""
+    travel = cfg.kind == "travel"
+    constants = np.array(
+        [
+            cfg.team_weight,
+            cfg.cell_reward,
+            cfg.travel_cost if travel else cfg.no_new_cell_penalty,
+            cfg.padding,
+            cfg.oscillation_penalty if cfg.kind == "reward2" else 0.0,
+            cfg.goal_bonus,
+            cfg.no_progress_penalty,
+            cfg.step_limit_penalty,
+        ]
+    )
+    constants.setflags(write=False)
+    return constants
+
+
+@compiled
+def _reward_table(
+    constants: np.ndarray,
+    travel: bool,
+    padding_truncates: bool,
+    no_progress_limit: int,
+    max_steps: int,
+    new_cells: np.ndarray,
+    padding: np.ndarray,
+    oscillation: np.ndarray,
+    threshold: np.ndarray,
+    no_frontier: np.ndarray,
+    steps: np.ndarray,
+    without_progress: np.ndarray,
+    moved: np.ndarray,
+    rewards: np.ndarray,
+    terminated: np.ndarray,
+    truncated: np.ndarray,
+    reason: np.ndarray,
+) -> None:
+    """The reward table, term by term in a fixed order (the same sums to the last bit for one
+    world or many): cells, then no-new-cell or travel, padding, oscillation, then the episode
+    terms. ``constants``: team weight, cell reward, no-new-cell penalty or travel cost,
+    padding, oscillation, goal bonus, no-progress and step-limit penalties."""
+    weight, cell, per_step, pad, osc, goal, stall, limit = constants
+    for w in range(new_cells.shape[0]):
+        team = 0
+        for n in range(new_cells.shape[1]):
+            team += new_cells[w, n]
+        any_padding = False
+        for n in range(new_cells.shape[1]):
+            new = new_cells[w, n]
+            credited = (1.0 - weight) * new + weight * team if weight != 0.0 else float(new)
+            value = cell * credited
+            if travel:
+                value += per_step * max(moved[w, n], 1)
+            elif new == 0:
+                value += per_step
+            if padding[w, n]:
+                value += pad
+                any_padding = True
+            if oscillation[w, n]:
+                value += osc
+            rewards[w, n] = value
+        code = 0
+        if threshold[w]:
+            code = THRESHOLD
+            for n in range(new_cells.shape[1]):
+                rewards[w, n] += goal
+        elif no_frontier[w]:
+            code = NO_FRONTIER
+        else:
+            if padding_truncates and any_padding:
+                code |= PADDING
+            if without_progress[w] >= no_progress_limit:
+                code |= NO_PROGRESS
+                for n in range(new_cells.shape[1]):
+                    rewards[w, n] += stall
+            if steps[w] >= max_steps:
+                code |= STEP_LIMIT
+                for n in range(new_cells.shape[1]):
+                    rewards[w, n] += limit
+        reason[w] = code
+        terminated[w] = code == THRESHOLD or code == NO_FRONTIER  # noqa: SIM109 (numba)
+        truncated[w] = code != 0 and not terminated[w]
 
 
 def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
@@ -181,6 +284,11 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
         np.array([events.steps_without_progress]),
         None if events.moved is None else np.asarray(events.moved, dtype=np.int64)[None],
     )
+    return first_outcome(outcome)
+
+
+def first_outcome(outcome: BatchOutcome) -> StepOutcome:
+    """World 0 of a batch's outcome, as one world's :class:`StepOutcome`."""
     return StepOutcome(
         outcome.rewards[0],
         bool(outcome.terminated[0]),

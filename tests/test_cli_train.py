@@ -209,3 +209,26 @@ def test_evaluate_the_shipped_model_by_name(tmp_path: Path, capsys) -> None:
     assert meta["validation"]["step"] == 340_000 and meta["validation"]["seed"] == 1000
     (model,) = result["rows"]
     assert model["episodes"] == 2 and sum(model["action_shares"]) == pytest.approx(1.0)
+
+
+def test_train_the_explorer_on_families_and_benchmark_it(tmp_path: Path, capsys) -> None:
+    """The shipped explorer config trains (tiny budget) on the four families with the slot
+    scorer, resumes, and the benchmark runs the model on validation episodes of every size."""
+    run_dir = tmp_path / "explorer"
+    overrides = ["--set", "dqn.learning_starts=50", "--set", "train.n_envs=1", "--no-progress"]
+    assert main(["train", "explorer", "--steps", "300", "--out", str(run_dir), *overrides]) == 0
+    meta = json.loads((run_dir / "model.json").read_text())
+    assert meta["observation_layout"]["features"] == "explorer"
+    assert "height" not in meta["observation_layout"]
+    assert main(["train", "--resume", str(run_dir), "--steps", "400", "--no-progress"]) == 0
+    out = tmp_path / "bench.json"
+    code = main(
+        ["benchmark", "--policies", f"nearest-path,{run_dir}", "--episodes", "1",
+         "--split", "validation", "--json", str(out), "--no-progress"]
+    )  # fmt: skip
+    assert code == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert {row["family"] for row in rows if row["policy"] == "explorer"} == {
+        "random-20", "random-30", "rooms-32", "rooms-64"
+    }  # fmt: skip
+    assert all(row["seeds"][0] == 800_000 for row in rows)

@@ -89,6 +89,7 @@ BAD_VALUES = [
     ("reward", "reward3", "reward"),
     ("travel_cost", math.nan, "travel_cost"),
     ("features", "pixels", "features"),
+    ("commit", "always", "commit"),
     ("foo", 1, "foo"),
     ("preset", "thesis-10x10", "preset"),
     ("config", "thesis-20x20", "config"),

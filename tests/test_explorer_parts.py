@@ -56,6 +56,18 @@ def test_explorer_observation_does_not_depend_on_the_map_size() -> None:
     assert small.observation_space("robot_0").contains(observation["robot_0"])
 
 
+def test_commit_narrows_the_mask_to_the_previous_target_until_progress() -> None:
+    from frontier_marl.core.slots import commit_to_previous
+
+    valid = np.array([[True, True, False], [True, True, False], [True, True, False]])
+    mask = valid.astype(np.int8)
+    target = np.array([[[1, 1], [4, 2], [-1, -1]]] * 3)
+    previous = np.array([[4, 2], [4, 2], [7, 7]])  # still offered, offered, gone
+    progressed = np.array([False, True, False])
+    narrowed = commit_to_previous(mask, target, valid, previous, progressed)
+    assert narrowed.tolist() == [[0, 1, 0], [1, 1, 0], [1, 1, 0]]
+
+
 def test_travel_reward_charges_every_cell_walked_and_idle_steps() -> None:
     cfg = make_config(reward="travel", travel_cost=-0.02, cell_reward=0.05).reward
     events = StepEvents([4, 0], [False, False], [False, False], False, False, 3, 0, [1, 0])
@@ -111,7 +123,11 @@ def test_masked_dqn_only_ever_picks_valid_slots() -> None:
             actions, _ = model.predict(observation, deterministic=deterministic)
             assert observation["action_mask"][np.arange(len(actions)), actions].all()
         observation, *_ = env.step(actions)
-    model.learn(200)  # trains through the masked target without error
+    model.learn(200)  # warm-up (random) and epsilon-greedy steps, trained through the target
+    buffer = model.replay_buffer
+    stored = buffer.observations["action_mask"][: buffer.pos]
+    taken = buffer.actions[: buffer.pos, :, 0]
+    assert np.take_along_axis(stored, taken[..., None], axis=2).all()
 
 
 def test_mixed_vec_env_joins_families_of_different_sizes() -> None:

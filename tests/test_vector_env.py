@@ -119,8 +119,16 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         {"n_agents": 3, "teammates": "positions+targets", "action_mask": True, "normalize": True},
         {"n_agents": 2, "teammates": "positions", "team_weight": 0.5, "gain": "unknown"},
         {"cells_per_step": "full", "map_mode": "dynamic", "start_cells": "any-free"},
+        {"features": "explorer", "commit": "until-progress", "reward": "travel", "max_steps": 40},
     ],
-    ids=["relative-sorted-r1", "box-distance-gain", "teammates-targets", "team-reward", "full"],
+    ids=[
+        "relative-sorted-r1",
+        "box-distance-gain",
+        "teammates-targets",
+        "team-reward",
+        "full",
+        "explorer-commit",
+    ],  # fmt: skip
 )
 def test_equality_holds_for_every_observation_and_reward_variant(kwargs: dict[str, Any]) -> None:
     assert play_side_by_side(2, 120, 3, "same-step", **kwargs) >= 1

@@ -30,7 +30,7 @@ TEAM_HEURISTICS = ("coordinated-assignment", "utility-discount")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.evaluation.benchmark import DEFAULT_EPISODES, FAMILIES
+    from frontier_marl.evaluation.benchmark import DEFAULT_EPISODES, FAMILIES, SPLITS
 
     parser.add_argument(
         "--families",
@@ -57,7 +57,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--episodes",
         type=positive_int,
         default=DEFAULT_EPISODES,
-        help="held-out episodes per family and policy (default: %(default)s)",
+        help="episodes per family and policy (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--split",
+        choices=list(SPLITS),
+        default="heldout",
+        help="which episodes: heldout (seeds 900,000+, the report's; the default) or validation "
+        "(seeds 800,000+, for model selection and tuning)",
     )
     parser.add_argument(
         "--agents", type=positive_int, default=1, help="robots per team (default: %(default)s)"
@@ -113,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
         commit = bench.default_commit(args.agents) if args.commit == "auto" else args.commit
         policies = bench.contenders(policy_names, commit)
         for fam in families:
-            fam.seeds(args.episodes)
+            fam.seeds(args.episodes, args.split)
             bench.variant_configs(fam, overrides, args.agents)
     except ValueError as exc:
         return fail("benchmark", str(exc))
@@ -126,12 +133,14 @@ def run(args: argparse.Namespace) -> int:
         overrides,
         progress=not args.no_progress,
         log=lambda text: print(text, file=sys.stderr),
+        split=args.split,
     )
     wall = time.perf_counter() - start
-    heldout = bench.HELDOUT_SEEDS.start
+    first = (bench.HELDOUT_SEEDS if args.split == "heldout" else bench.VALIDATION_SEEDS).start
+    split = "held-out" if args.split == "heldout" else "validation"
     title = (
-        f"{args.episodes} held-out episodes per family (seeds {heldout}..."
-        f"{heldout + args.episodes - 1}), {args.agents} robot(s)"
+        f"{args.episodes} {split} episodes per family (seeds {first}..."
+        f"{first + args.episodes - 1}), {args.agents} robot(s)"
         + (f", {' '.join(args.overrides)}" if args.overrides else "")
     )
     print(title)
@@ -147,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
             "maps": list(args.maps),
             "policies": policy_names,
             "episodes": args.episodes,
+            "split": args.split,
             "agents": args.agents,
             "commit": commit,
             "set": list(args.overrides),

@@ -89,6 +89,21 @@ class SlotTable:
         return self.mask
 
 
+def commit_to_previous(
+    mask: np.ndarray,
+    target: np.ndarray,
+    valid: np.ndarray,
+    previous: np.ndarray,
+    progressed: np.ndarray,
+) -> np.ndarray:
+    """Action masks ``(..., S)`` narrowed to the slot of each robot's ``previous`` target cell
+    ``(..., 2)`` (row -1: none) where its last step revealed nothing (``progressed`` False)
+    and a live slot still holds that target; the other robots' masks unchanged."""
+    same = valid & (target == previous[..., None, :]).all(axis=-1) & (previous[..., None, 0] >= 0)
+    keep = same.any(axis=-1) & ~progressed
+    return np.where(keep[..., None], same.astype(mask.dtype), mask)
+
+
 def robot_slots(
     belief: np.ndarray,
     position: tuple[int, int],

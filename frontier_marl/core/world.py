@@ -15,7 +15,7 @@ import numpy as np
 
 from frontier_marl.core.frontiers import Clusters
 from frontier_marl.core.slots import SlotTable, robot_slots
-from frontier_marl.core.worlds import FULL_PATH, WorldParams, Worlds
+from frontier_marl.core.worlds import FULL_PATH, SlotArrays, WorldParams, Worlds
 
 __all__ = ["FULL_PATH", "MoveResult", "World", "WorldParams"]
 
@@ -67,6 +67,8 @@ class World:
         self._worlds = worlds
         self._index = index
         self.params = worlds.params
+        self._active = np.zeros(worlds.n_worlds, dtype=bool)
+        self._active[index] = True
         self._make_views()
 
     def _make_views(self) -> None:
@@ -141,6 +143,12 @@ class World:
         self._worlds.refresh_clusters()
         return self._worlds.gains[self._index, : self._worlds.n_clusters[self._index]]
 
+    def slot_arrays(self, n_slots: int, sort_by_distance: bool) -> SlotArrays:
+        """The slots of every robot, ``(K, n_slots, ...)`` arrays from one compiled call."""
+        out = SlotArrays.empty(self._worlds.n_worlds, self.n_agents, n_slots)
+        self._worlds.slots(out, np.array([self._index]), sort_by_distance)
+        return out.world(self._index)
+
     def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""
         clusters = self.clusters()
@@ -161,15 +169,13 @@ class World:
         w, i = self._worlds, self._index
         if len(targets) != w.n_agents:
             raise ValueError(f"expected {w.n_agents} targets, got {len(targets)}")
-        goals = w.goals.copy()
+        goals = w.goals  # only this world is active: the others' goals are not read
         if isinstance(targets, np.ndarray):
             goals[i] = targets
         else:
             for agent, target in enumerate(targets):
                 goals[i, agent] = (-1, -1) if target is None else target
-        active = np.zeros(w.n_worlds, dtype=bool)
-        active[i] = True
-        w.move(goals, active)
+        w.move(goals, self._active)
         return move_result(w, i)
 
 

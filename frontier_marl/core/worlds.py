@@ -72,6 +72,16 @@ class SlotArrays:
         fields = {name: np.stack([getattr(t, name) for t in tables]) for name in _FIELDS}
         return cls(**fields, live=np.array([t.live for t in tables], dtype=np.int64))
 
+    def table(self, row: int) -> SlotTable:
+        """Robot ``row``'s :class:`SlotTable` (views) of ``(M, ...)`` arrays."""
+        fields = {name: getattr(self, name)[row] for name in _FIELDS}
+        return SlotTable(**fields, live=int(self.live[row]))
+
+    def world(self, index: int) -> SlotArrays:
+        """The robots of world ``index`` of a batch as ``(K, ...)`` arrays (views)."""
+        fields = {name: getattr(self, name)[index] for name in (*_FIELDS, "live")}
+        return SlotArrays(**fields)
+
     def rows(self, worlds: np.ndarray | slice) -> SlotArrays:
         """The robots of ``worlds`` of a batch as ``(M, ...)`` arrays, world after world."""
         fields = {name: getattr(self, name)[worlds] for name in (*_FIELDS, "live")}
@@ -82,18 +92,19 @@ class SlotArrays:
 
     @classmethod
     def empty(cls, n_worlds: int, n_agents: int, n_slots: int) -> SlotArrays:
+        """Uninitialised arrays for :meth:`Worlds.slots` to fill."""
         shape = (n_worlds, n_agents, n_slots)
         return cls(
-            cluster=np.full(shape, -1, dtype=np.int64),
-            valid=np.zeros(shape, dtype=bool),
-            centroid=np.zeros((*shape, 2)),
-            target=np.full((*shape, 2), -1, dtype=np.int64),
-            distance=np.zeros(shape),
-            size=np.zeros(shape, dtype=np.int64),
-            gain=np.zeros(shape),
-            path_length=np.full(shape, -1, dtype=np.int64),
-            mask=np.zeros(shape, dtype=np.int8),
-            live=np.zeros(shape[:2], dtype=np.int64),
+            cluster=np.empty(shape, dtype=np.int64),
+            valid=np.empty(shape, dtype=bool),
+            centroid=np.empty((*shape, 2)),
+            target=np.empty((*shape, 2), dtype=np.int64),
+            distance=np.empty(shape),
+            size=np.empty(shape, dtype=np.int64),
+            gain=np.empty(shape),
+            path_length=np.empty(shape, dtype=np.int64),
+            mask=np.empty(shape, dtype=np.int8),
+            live=np.empty(shape[:2], dtype=np.int64),
         )
 
 
@@ -139,6 +150,7 @@ class Worlds:
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
         self._structure = stacked_structure(params.connectivity)
+        self._fractions: dict[str, tuple[int, np.ndarray]] = {}
 
     # ----------------------------------------------------------------- episodes
     def place(
@@ -188,7 +200,8 @@ class Worlds:
     def move(self, goals: np.ndarray, active: np.ndarray) -> None:
         """Walk every robot of the ``active`` worlds toward ``goals`` (N, K, 2; row -1: stay);
         the outputs are left in ``new_cells``, ``walked``, ``walked_len`` and ``reached``."""
-        self.goals[:] = goals
+        if goals is not self.goals:
+            self.goals[:] = goals
         offsets, between = self.params.sensor.rays
         walk_worlds(
             active,
@@ -282,7 +295,17 @@ class Worlds:
 
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
-        of the ``reachable`` free region known."""
+        of the ``reachable`` free region known (kept until a belief changes; read-only)."""
+        key = int(self.version.sum())  # versions only grow: the sum moves with any of them
+        cached = self._fractions.get(basis)
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        fraction = self._explored_fraction(basis)
+        fraction.setflags(write=False)
+        self._fractions[basis] = (key, fraction)
+        return fraction
+
+    def _explored_fraction(self, basis: str) -> np.ndarray:
         belief = self.belief
         if basis == "all":
             return np.count_nonzero(belief != UNKNOWN, axis=(1, 2)) / belief[0].size

@@ -42,6 +42,7 @@ TRAIN_SEEDS = range(0, 800_000)
 #: Seeds for validation (model selection) on a family.
 VALIDATION_SEEDS = range(800_000, 900_000)
 DEFAULT_EPISODES = 30
+SPLITS = ("heldout", "validation")
 #: Slots offered to the heuristics: the env's maximum, so they choose among every reachable
 #: cluster (the benchmark counts the decisions where all of them were full).
 HEURISTIC_SLOTS = 256
@@ -82,11 +83,15 @@ class MapFamily:
     def env_kwargs(self) -> dict[str, Any]:
         return dict(self.env)
 
-    def seeds(self, episodes: int) -> list[int]:
-        """The held-out reset seeds of the first ``episodes`` episodes."""
-        if episodes < 1 or episodes > len(self.heldout):
-            raise ValueError(f"episodes must be in [1, {len(self.heldout)}], got {episodes}")
-        return list(self.heldout[:episodes])
+    def seeds(self, episodes: int, split: str = "heldout") -> list[int]:
+        """The reset seeds of the first ``episodes`` episodes of ``split``: ``heldout`` (the
+        report's) or ``validation`` (for model selection and tuning)."""
+        if split not in SPLITS:
+            raise ValueError(f"split must be one of {list(SPLITS)}, got {split!r}")
+        seeds = self.heldout if split == "heldout" else self.validation
+        if episodes < 1 or episodes > len(seeds):
+            raise ValueError(f"episodes must be in [1, {len(seeds)}], got {episodes}")
+        return list(seeds[:episodes])
 
 
 def _family(name: str, description: str, **env: Any) -> MapFamily:
@@ -188,7 +193,7 @@ def variant_configs(
 
             height, width = load_map(path).shape
             kwargs.update(map_path=path, perception_range=loaded_map_range(height, width))
-        kwargs.update(n_slots=HEURISTIC_SLOTS, n_agents=agents, **overrides)
+        kwargs.update({"n_slots": HEURISTIC_SLOTS, "n_agents": agents, **overrides})
         try:
             shape = make_config(**kwargs).shape  # the size after the overrides
             kwargs.update({**episode_settings(*shape), **overrides})
@@ -306,16 +311,18 @@ def run_family(
     worlds: Sequence[EnvConfig],
     episodes: int,
     on_episode: Callable[[EpisodeRecord], None] | None = None,
+    split: str = "heldout",
 ) -> EvaluationResult:
-    """``episodes`` held-out episodes of one policy on one family (``worlds`` from
-    :func:`variant_configs`); the result's ``extra`` holds the family, maps and seeds."""
+    """``episodes`` episodes of ``split`` (:meth:`MapFamily.seeds`) of one policy on one
+    family (``worlds`` from :func:`variant_configs`); the result's ``extra`` holds the family,
+    maps and seeds."""
     import time
 
     from frontier_marl.envs.parallel import FrontierParallelEnv
     from frontier_marl.evaluation.protocol import evaluate
 
     start = time.perf_counter()
-    seeds = fam.seeds(episodes)
+    seeds = fam.seeds(episodes, split)
     configs = [contender.config(world) for world in worlds]
     envs = [FrontierParallelEnv(config=cfg) for cfg in configs]
     policy = _SlotWatch(contender.make())
@@ -361,8 +368,10 @@ def run_benchmark(
     overrides: Mapping[str, Any] | None = None,
     progress: bool = False,
     log: Callable[[str], None] | None = None,
+    split: str = "heldout",
 ) -> list[dict[str, Any]]:
-    """Every policy on every family's held-out episodes; one row per (family, policy) with
+    """Every policy on every family's held-out (or ``validation``) episodes; one row per
+    (family, policy) with
     the comparison to the family's best heuristic
     (:func:`~frontier_marl.evaluation.benchmark_stats.compare`). A model that cannot act on a
     family (e.g. another map size) is skipped there, with a note to ``log``."""
@@ -374,7 +383,7 @@ def run_benchmark(
         raise ValueError(f"family names must be distinct, got {[f.name for f in families]}")
     worlds = [variant_configs(fam, overrides, agents) for fam in families]
     for fam in families:
-        fam.seeds(episodes)  # validates the episode count
+        fam.seeds(episodes, split)  # validates the episode count and the split
     rows = []
     total = len(families) * len(policies) * episodes
     with progress_bar(total, disable=not progress, unit="ep") as bar:
@@ -382,7 +391,9 @@ def run_benchmark(
             for contender in policies:
                 bar.set_description(f"{fam.name} {contender.name}")
                 try:
-                    result = run_family(fam, contender, configs, episodes, lambda _r: bar.update(1))
+                    result = run_family(
+                        fam, contender, configs, episodes, lambda _r: bar.update(1), split
+                    )
                 except ModelEnvMismatchError as exc:
                     if contender.heuristic:
                         raise

@@ -117,10 +117,21 @@ class MaskedDQN(DQN):
     ) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:
         if deterministic or np.random.rand() >= self.exploration_rate:
             return self.policy.predict(observation, state, episode_start, deterministic)
+        return self._random_valid(observation), state
+
+    def _sample_action(
+        self, learning_starts: int, action_noise: Any = None, n_envs: int = 1
+    ) -> tuple[np.ndarray, np.ndarray]:
+        if self.num_timesteps < learning_starts:  # SB3 would draw among every action here
+            actions = self._random_valid(self._last_obs)
+            return actions, actions
+        return super()._sample_action(learning_starts, action_noise, n_envs)
+
+    def _random_valid(self, observation: Any) -> np.ndarray:
+        """One uniformly random valid slot per observation (the action space's generator)."""
         assert isinstance(observation, dict)
         mask = np.asarray(observation["action_mask"])
-        single = mask.ndim == 1
         masks = mask.reshape(-1, mask.shape[-1]).astype(bool)
         draws = self.action_space.np_random.random(masks.shape)
         actions = np.where(masks, draws, -1.0).argmax(axis=1)
-        return (actions[0] if single else actions), state
+        return actions[0] if mask.ndim == 1 else actions

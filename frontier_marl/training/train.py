@@ -241,10 +241,14 @@ def train(
     if settings.validate_every > 0:
         from frontier_marl.training.validation import BestPolicyKeeper
 
-        keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, start_step)
-        all_callbacks.append(
-            Periodic(settings.validate_every, keeper, log_key="eval/validation_mean_reward")
-        )
+        scorer, log_key = None, "eval/validation_mean_reward"
+        if settings.families:
+            from frontier_marl.training.family_validation import FamilyValidator
+
+            scorer = FamilyValidator(settings.families, settings.validation_episodes, cfg)
+            log_key = "eval/validation_score"
+        keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, start_step, scorer)
+        all_callbacks.append(Periodic(settings.validate_every, keeper, log_key=log_key))
 
     remaining = settings.total_timesteps - model.num_timesteps
     interrupted = False

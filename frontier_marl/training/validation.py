@@ -5,7 +5,9 @@ With ``train.validate_every = N`` a run scores its greedy (epsilon = 0) policy e
 disjoint from the evaluation's), appends each score to ``RUN/validation.jsonl``, and keeps the
 best-scoring policy in ``RUN/best/`` (``model.zip`` + ``model.json``, whose ``validation`` entry
 says at which step and with which score). This is SB3's ``EvalCallback(best_model_save_path=...)``
-practice; the thesis protocol's episodes are never used to choose.
+practice; the thesis protocol's episodes are never used to choose. A run on benchmark families
+(``train.families``) is scored by :class:`~frontier_marl.training.family_validation.FamilyValidator`
+instead: T99 against nearest-path on the families' validation episodes.
 """
 
 from __future__ import annotations
@@ -28,7 +30,8 @@ LOG_FILE = "validation.jsonl"
 
 class BestPolicyKeeper:
     """``keeper(model)`` validates ``model`` and saves it to ``RUN/best/`` if it is the best so
-    far; returns the validation mean reward."""
+    far; returns the validation score (the mean reward, unless ``scorer`` is given: a function
+    of the model returning a record with a ``score``, higher is better)."""
 
     def __init__(
         self,
@@ -37,12 +40,14 @@ class BestPolicyKeeper:
         settings: TrainSettings,
         metadata: Callable[[], dict[str, Any]],
         start_step: int = 0,
+        scorer: Callable[[Any], dict[str, Any]] | None = None,
     ) -> None:
         self.run_dir = run_dir
         self.cfg = cfg
         self.episodes = settings.validation_episodes
         self.seed = settings.validation_seed
         self.metadata = metadata
+        self.scorer = scorer or self._mean_reward
         self.best_score = -math.inf
         self._forget_after(start_step)
 
@@ -61,11 +66,12 @@ class BestPolicyKeeper:
         self.log_path.write_text("".join(json.dumps(r) + "\n" for r in records))
         best = load_metadata(self.best_dir / MODEL_FILE)
         if best is not None and best.get("validation", {}).get("step", math.inf) <= step:
-            self.best_score = float(best["validation"]["mean_reward"])
+            record = best["validation"]
+            self.best_score = float(record.get("score", record.get("mean_reward")))
         elif self.best_dir.exists():
             shutil.rmtree(self.best_dir)
 
-    def __call__(self, model: Any) -> float:
+    def _mean_reward(self, model: Any) -> dict[str, Any]:
         from frontier_marl.evaluation import ModelPolicy, evaluate
 
         result = evaluate(
@@ -74,8 +80,8 @@ class BestPolicyKeeper:
             episodes=self.episodes,
             seed=self.seed,
         )
-        record = {
-            "step": int(model.num_timesteps),
+        return {
+            "score": result.mean_reward,
             "mean_reward": result.mean_reward,
             "std_reward": result.std_reward,
             "terminations": result.terminations,
@@ -83,16 +89,19 @@ class BestPolicyKeeper:
             "seed": self.seed,
             "map_mode": self.cfg.map_mode,
         }
+
+    def __call__(self, model: Any) -> float:
+        record = {"step": int(model.num_timesteps), **self.scorer(model)}
         with self.log_path.open("a") as handle:
             handle.write(json.dumps(record) + "\n")
-        if record["mean_reward"] > self.best_score:
-            self.best_score = record["mean_reward"]
+        if record["score"] > self.best_score:
+            self.best_score = record["score"]
             self.best_dir.mkdir(exist_ok=True)
             model.save(self.best_dir / MODEL_FILE)
             meta = self.metadata()
             meta["validation"] = record
             save_metadata(meta, self.best_dir / "model.json")
-        return float(record["mean_reward"])
+        return float(record["score"])
 
 
 def read_validation_log(run_dir: str | Path) -> list[dict[str, Any]]:
