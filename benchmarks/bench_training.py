@@ -63,7 +63,7 @@ def stage_functions() -> list[tuple[object, str]]:
         (engine.ExplorationMDP, "_refresh_slots"),  # clusters (with ndimage.label) and slots
         (ndimage, "label"),
         (engine.ExplorationMDP, "_observations"),
-        (engine, "step_outcome"),  # the reward table
+        (engine, "batch_outcome"),  # the reward table
         (parallel, "build_infos"),  # the info dicts
         (engine.ExplorationMDP, "reset"),
     ]

@@ -23,7 +23,7 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
         "_refresh_slots",
         "ndimage.label",
         "_observations",
-        "step_outcome",
+        "batch_outcome",
         "build_infos",
         "reset",
     }
@@ -39,10 +39,10 @@ def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
     from frontier_marl import engine
     from frontier_marl.core import world
 
-    before = (world.World.move, engine.step_outcome, engine.ExplorationMDP.reset)
+    before = (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset)
     main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
     main(["config01", "--steps", "200", "--stages"])
-    assert (world.World.move, engine.step_outcome, engine.ExplorationMDP.reset) == before
+    assert (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset) == before
 
 
 def test_labelling_benchmark_counts(tmp_path: Path) -> None:

@@ -63,3 +63,21 @@ def test_gif_invalid_values_exit_2(tmp_path, argv, capsys):
     assert main(["gif", "--out", str(tmp_path / "x.gif"), *argv]) == 2
     assert "error" in capsys.readouterr().err
     assert not (tmp_path / "x.gif").exists()
+
+
+def test_gif_beside_draws_two_policies_on_the_same_episode(tmp_path, capsys):
+    out = tmp_path / "side.gif"
+    argv = ["gif", "--policy", "greedy-gain", "--beside", "nearest-path", "--out", str(out)]
+    assert main([*argv, "--cell-px", "4", "--seed", "2", *SMALL_ARGS]) == 0
+    frames = iio.imread(out, index=None)
+    single = (2 * 9 + 1) * 4
+    assert frames.shape[2] == 2 * single + 8
+    # both halves start from the same reset: the same map and start
+    np.testing.assert_array_equal(frames[0][:, :single], frames[0][:, single + 8 :])
+    printed = capsys.readouterr().out
+    assert "greedy-gain" in printed and "nearest-path" in printed
+
+
+def test_gif_refuses_an_unknown_policy(tmp_path, capsys):
+    assert main(["gif", "--policy", "nosuch", "--out", str(tmp_path / "x.gif")]) == 2
+    assert "unknown policy 'nosuch'" in capsys.readouterr().err

@@ -1,8 +1,9 @@
-"""``frontier-marl gif``: run one episode with a heuristic and write it as a GIF.
+"""``frontier-marl gif``: run one episode with a heuristic or a model and write it as a GIF.
 
-Example::
+Examples::
 
     frontier-marl gif --policy greedy-distance --preset thesis-20x20 --seed 0 --out episode.gif
+    frontier-marl gif --policy explorer --beside nearest-path --map rooms-64 --out side.gif
 
 The frames show the true grid beside the robots' belief, the frontier clusters and their
 centroids, the robots, their last paths and targets (see :mod:`frontier_marl.render`).
@@ -29,9 +30,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument(
         "--policy",
-        choices=list(POLICIES),
         default="greedy-distance",
-        help="heuristic driving the robots (default: %(default)s)",
+        help=f"heuristic ({', '.join(POLICIES)}) or model (a shipped model's name, a run "
+        "folder or a model.zip) driving the robots (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--beside",
+        default=None,
+        help="a second policy run on the same episode, drawn to the right of the first",
     )
     add_env_arguments(parser)
     parser.add_argument(
@@ -72,13 +78,17 @@ def record_episode(
     cell_px: int = 12,
     max_steps: int | None = None,
 ) -> tuple[list[np.ndarray], float, int, str]:
-    """Frames (reset included), team-mean return, decision steps and end reason."""
+    """Frames (reset included), team-mean return, decision steps and end reason of one
+    episode of ``policy_name`` (a heuristic, or a model on its own observation settings)."""
     import frontier_marl
-    from frontier_marl.evaluation import make_policy
+    from frontier_marl.config import make_config
+    from frontier_marl.evaluation.benchmark import contenders
 
-    env = frontier_marl.parallel_env(render_mode="rgb_array", **env_kwargs)
+    contender = contenders([policy_name])[0]
+    cfg = contender.config(make_config(**env_kwargs))
+    env = frontier_marl.parallel_env(render_mode="rgb_array", config=cfg)
     try:
-        policy = make_policy(policy_name, seed)
+        policy = contender.make()
         policy.attach(env)
         observations, infos = env.reset(seed=seed)
         frames = [render_frame(env, cell_px)]
@@ -100,6 +110,21 @@ def record_episode(
     return frames, float(np.mean(list(returns.values()))), steps, reason
 
 
+def side_by_side(left: list[np.ndarray], right: list[np.ndarray]) -> list[np.ndarray]:
+    """Frames of two episodes next to each other (a white gap between); the shorter episode
+    holds its last frame."""
+    count = max(len(left), len(right))
+    height = max(left[0].shape[0], right[0].shape[0])
+
+    def at(frames: list[np.ndarray], i: int) -> np.ndarray:
+        frame = frames[min(i, len(frames) - 1)]
+        pad = np.full((height - frame.shape[0], *frame.shape[1:]), 255, dtype=frame.dtype)
+        return np.concatenate([frame, pad], axis=0)
+
+    gap = np.full((height, 8, 3), 255, dtype=left[0].dtype)
+    return [np.concatenate([at(left, i), gap, at(right, i)], axis=1) for i in range(count)]
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         env_kwargs = env_kwargs_from_args(args)
@@ -109,14 +134,24 @@ def run(args: argparse.Namespace) -> int:
         return fail("gif", str(exc))
     from frontier_marl.viewer import write_gif
 
-    frames, reward, steps, reason = record_episode(
-        env_kwargs, args.policy, args.seed, args.cell_px, args.max_steps
-    )
+    names = [args.policy] + ([args.beside] if args.beside else [])
+    episodes = []
+    try:
+        for name in names:
+            episodes.append(
+                record_episode(env_kwargs, name, args.seed, args.cell_px, args.max_steps)
+            )
+    except ValueError as exc:
+        return fail("gif", str(exc))
+    frames = episodes[0][0]
+    if len(episodes) == 2:
+        frames = side_by_side(frames, episodes[1][0])
     args.out.parent.mkdir(parents=True, exist_ok=True)
     write_gif(frames, args.out, fps=args.fps)
-    print(f"wrote {args.out}")
-    print(
-        f"policy {args.policy}, seed {args.seed}: reward {reward:.2f}, {steps} steps, "
-        f"end: {reason or 'none'}"
-    )
+    print(f"wrote {args.out}" + (f" ({names[0]} left, {names[1]} right)" if args.beside else ""))
+    for name, (_, reward, steps, reason) in zip(names, episodes, strict=True):
+        print(
+            f"policy {name}, seed {args.seed}: reward {reward:.2f}, {steps} steps, "
+            f"end: {reason or 'none'}"
+        )
     return 0

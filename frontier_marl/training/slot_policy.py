@@ -23,6 +23,7 @@ from stable_baselines3 import DQN
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
+from torch.nn import functional as F
 
 MASKED_Q = -1e9  # the Q-value of a masked slot: below any return
 
@@ -51,7 +52,8 @@ class SlotExtractor(BaseFeaturesExtractor):
 
 class SlotScorer(nn.Module):
     """Q-values of S slots from ``(B, S * F + S)`` (features, then mask): a shared encoder
-    per slot, mean and max pooling over the live slots, a shared scorer per slot."""
+    per slot, mean and max pooling over the live slots, a shared advantage scorer per slot and
+    a state value from the pooled context (a dueling head)."""
 
     def __init__(
         self, n_slots: int, n_features: int, hidden: list[int], activation: type[nn.Module]
@@ -61,6 +63,7 @@ class SlotScorer(nn.Module):
         width = hidden[-1]
         self.encode = _mlp([n_features, *hidden], activation)
         self.score = nn.Sequential(_mlp([3 * width, *hidden], activation), nn.Linear(width, 1))
+        self.value = nn.Sequential(_mlp([2 * width, width], activation), nn.Linear(width, 1))
 
     def forward(self, flat: th.Tensor) -> th.Tensor:
         batch, s, f = flat.shape[0], self.n_slots, self.n_features
@@ -72,8 +75,13 @@ class SlotScorer(nn.Module):
         mean = (encoded * live).sum(dim=1) / count
         top = encoded.masked_fill(~live, -th.inf).max(dim=1).values
         top = th.where(th.isfinite(top), top, th.zeros_like(top))
-        context = th.cat([mean, top], dim=1).unsqueeze(1).expand(-1, s, -1)
-        q_values = self.score(th.cat([encoded, context], dim=2)).squeeze(-1)
+        pooled = th.cat([mean, top], dim=1)
+        context = pooled.unsqueeze(1).expand(-1, s, -1)
+        advantage = self.score(th.cat([encoded, context], dim=2)).squeeze(-1)
+        # dueling: a state value from the pooled context plus each slot's advantage, centred
+        # on the live slots' mean advantage
+        centre = (advantage * live.squeeze(-1)).sum(dim=1, keepdim=True) / count
+        q_values = self.value(pooled) + advantage - centre
         return q_values.masked_fill(~mask, MASKED_Q)
 
 
@@ -104,9 +112,32 @@ class SlotDQNPolicy(DQNPolicy):
 class MaskedDQN(DQN):
     """DQN whose epsilon-random actions are drawn among the valid slots (the observation's
     ``action_mask``); with :class:`SlotDQNPolicy` its greedy and target actions are masked
-    too."""
+    too. Its TD target is Double DQN's: the online network picks the next action, the target
+    network values it (less overestimation of the max over many slots)."""
 
     policy_aliases = {**DQN.policy_aliases, "SlotPolicy": SlotDQNPolicy}  # noqa: RUF012
+
+    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
+        self.policy.set_training_mode(True)
+        self._update_learning_rate(self.policy.optimizer)
+        losses = []
+        for _ in range(gradient_steps):
+            data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]
+            discounts = data.discounts if data.discounts is not None else self.gamma
+            with th.no_grad():
+                next_actions = self.q_net(data.next_observations).argmax(dim=1, keepdim=True)
+                next_q = th.gather(self.q_net_target(data.next_observations), 1, next_actions)
+                target = data.rewards + (1 - data.dones) * discounts * next_q
+            current = th.gather(self.q_net(data.observations), 1, data.actions.long())
+            loss = F.smooth_l1_loss(current, target)
+            losses.append(loss.item())
+            self.policy.optimizer.zero_grad()
+            loss.backward()
+            th.nn.utils.clip_grad_norm_(self.policy.parameters(), self.max_grad_norm)
+            self.policy.optimizer.step()
+        self._n_updates += gradient_steps
+        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        self.logger.record("train/loss", np.mean(losses))
 
     def predict(
         self,
