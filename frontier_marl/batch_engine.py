@@ -97,9 +97,14 @@ class BatchMDP:
         self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + 1)
         indices = self._all[active]
         worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
-        if self.cfg.observation.commit == "until-progress":
+        if self.cfg.observation.commit != "none":
             slots.mask[:] = commit_to_previous(
-                slots.mask, slots.target, slots.valid, targets, new_cells > 0
+                slots.mask,
+                slots.target,
+                slots.valid,
+                targets,
+                new_cells > 0,
+                self.cfg.observation.commit,
             )
         reward = self.cfg.reward
         fraction = worlds.explored_fraction(reward.threshold_basis)

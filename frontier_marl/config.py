@@ -35,7 +35,7 @@ ThresholdBasis = Literal["all", "free", "reachable"]
 RewardKind = Literal["reward1", "reward2", "travel"]
 TeammateEncoding = Literal["none", "positions", "positions+targets"]
 FeatureLayout = Literal["thesis", "explorer"]
-CommitRule = Literal["none", "until-progress"]
+CommitRule = Literal["none", "until-progress", "until-reached"]
 FULL_PATH = "full"
 
 _CENTROIDS = ("absolute", "relative", "distance", "none")
@@ -48,7 +48,7 @@ _BASES = ("all", "free", "reachable")
 _REWARDS = ("reward1", "reward2", "travel")
 _TEAMMATES = ("none", "positions", "positions+targets")
 _FEATURES = ("thesis", "explorer")
-_COMMITS = ("none", "until-progress")
+_COMMITS = ("none", "until-progress", "until-reached")
 
 
 @dataclass(frozen=True)
@@ -73,7 +73,9 @@ class ObservationConfig:
             the axes above are then unused.
         commit: ``until-progress`` narrows a robot's action mask to the slot of its previous
             target while its last step revealed no new cell and that target is still offered
-            (the heuristics' livelock rule, docs/calibration.md, for a learned policy); ``none``
+            (the heuristics' livelock rule, docs/calibration.md, for a learned policy);
+            ``until-reached`` keeps it whatever the step revealed, until the robot reaches it or
+            it is no longer offered (a decision picks the next frontier to go to); ``none``
             (the default) leaves every live slot valid.
     """
 

@@ -111,10 +111,15 @@ class ExplorationMDP:
         self.steps_without_progress = 0 if new_cells.any() else self.steps_without_progress + 1
         self._refresh_slots()
         assert self._slot_arrays is not None
-        if cfg.observation.commit == "until-progress":
+        if cfg.observation.commit != "none":
             arrays = self._slot_arrays
             arrays.mask[:] = commit_to_previous(
-                arrays.mask, arrays.target, arrays.valid, targets, new_cells > 0
+                arrays.mask,
+                arrays.target,
+                arrays.valid,
+                targets,
+                new_cells > 0,
+                cfg.observation.commit,
             )
         fraction = world.explored_fraction(cfg.reward.threshold_basis)
         outcome = first_outcome(

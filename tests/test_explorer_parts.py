@@ -66,6 +66,27 @@ def test_commit_narrows_the_mask_to_the_previous_target_until_progress() -> None
     progressed = np.array([False, True, False])
     narrowed = commit_to_previous(mask, target, valid, previous, progressed)
     assert narrowed.tolist() == [[0, 1, 0], [1, 1, 0], [1, 1, 0]]
+    kept = commit_to_previous(mask, target, valid, previous, progressed, "until-reached")
+    assert kept.tolist() == [[0, 1, 0], [0, 1, 0], [1, 1, 0]]  # progress does not release it
+
+
+def test_heuristics_take_the_until_reached_rule() -> None:
+    from frontier_marl.evaluation import make_policy
+
+    env = frontier_marl.parallel_env(preset="rooms-32", n_slots=16)
+    for name in ("nearest-path", "coordinated-assignment"):
+        policy = make_policy(name, commit="until-reached")
+        policy.attach(env)
+        observations, infos = env.reset(seed=1)
+        previous = None
+        for _ in range(60):
+            actions = policy.act_team(observations, infos)
+            observations, _, _, _, infos = env.step(actions)
+            target, table = infos["robot_0"]["target"], infos["robot_0"]["slots"]
+            offered = {tuple(cell) for cell in table.target[: table.live].tolist()}
+            if previous is not None and previous in offered and target != previous:
+                raise AssertionError(f"{name} left an offered target {previous} for {target}")
+            previous = target if infos["robot_0"]["position"] != target else None
 
 
 def test_travel_reward_charges_every_cell_walked_and_idle_steps() -> None:

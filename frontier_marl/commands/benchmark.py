@@ -71,7 +71,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--commit",
-        choices=["auto", "until-progress", "none"],
+        choices=["auto", "until-progress", "until-reached", "none"],
         default="auto",
         help="the heuristics' commit rule; auto (the default): until-progress with one robot "
         "(it prevents livelocks), none with a team (docs/benchmark.md)",

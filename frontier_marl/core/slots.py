@@ -95,12 +95,16 @@ def commit_to_previous(
     valid: np.ndarray,
     previous: np.ndarray,
     progressed: np.ndarray,
+    rule: str = "until-progress",
 ) -> np.ndarray:
     """Action masks ``(..., S)`` narrowed to the slot of each robot's ``previous`` target cell
-    ``(..., 2)`` (row -1: none) where its last step revealed nothing (``progressed`` False)
-    and a live slot still holds that target; the other robots' masks unchanged."""
+    ``(..., 2)`` (row -1: none) where a live slot still holds that target and, for
+    ``until-progress``, the robot's last step revealed nothing (``progressed`` False;
+    ``until-reached`` keeps it regardless); the other robots' masks unchanged."""
     same = valid & (target == previous[..., None, :]).all(axis=-1) & (previous[..., None, 0] >= 0)
-    keep = same.any(axis=-1) & ~progressed
+    keep = same.any(axis=-1)
+    if rule == "until-progress":
+        keep &= ~progressed
     return np.where(keep[..., None], same.astype(mask.dtype), mask)
 
 

@@ -60,9 +60,10 @@ class Policy:
         return f"{type(self).__name__}(name={self.name!r})"
 
 
-#: ``commit`` values of the heuristics: re-decide every step (the thesis's greedy rule), or
-#: keep the previous target while the last step revealed no new cell.
-COMMIT_RULES: tuple[str, ...] = ("none", "until-progress")
+#: ``commit`` values of the heuristics: re-decide every step (the thesis's greedy rule), keep
+#: the previous target while the last step revealed no new cell, or keep it until it is
+#: reached or no longer offered (decide only on arrival).
+COMMIT_RULES: tuple[str, ...] = ("none", "until-progress", "until-reached")
 
 
 def check_commit(commit: str) -> str:
@@ -79,15 +80,16 @@ class HeuristicPolicy(Policy):
             headed for in the last step (``info["target"]``) while that step revealed no new
             cell (``info["new_cells"] == 0``) and the target is still offered in a slot: the
             clusters have not changed, so the robot walks on instead of turning back and forth
-            between two clusters (docs/calibration.md, "Livelocks").
+            between two clusters (docs/calibration.md, "Livelocks"). ``until-reached`` keeps
+            it whatever the step revealed, until it is reached or no longer offered.
     """
 
     def __init__(self, commit: str = "none") -> None:
         self.commit = check_commit(commit)
 
     def act(self, obs: Any, info: Info) -> int:
-        if self.commit == "until-progress":
-            kept = kept_slot(info)
+        if self.commit != "none":
+            kept = kept_slot(info, self.commit)
             if kept is not None:
                 return kept
         return int(self.choose(info))
@@ -96,10 +98,12 @@ class HeuristicPolicy(Policy):
         raise NotImplementedError
 
 
-def kept_slot(info: Info) -> int | None:
-    """The slot of the robot's previous target when its last step revealed nothing and the
-    target is still offered, else ``None``."""
-    return None if info["new_cells"] else previous_target_slot(info)
+def kept_slot(info: Info, commit: str = "until-progress") -> int | None:
+    """The slot of the robot's previous target while it is still offered (and, for
+    ``until-progress``, while its last step revealed nothing), else ``None``."""
+    if commit == "until-progress" and info["new_cells"]:
+        return None
+    return previous_target_slot(info)
 
 
 def previous_target_slot(info: Info) -> int | None:

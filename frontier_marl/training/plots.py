@@ -185,3 +185,33 @@ def plot_action_comparison(
         fig.savefig(os.fspath(path), dpi=110)
     finally:
         plt.close(fig)
+
+
+def plot_family_validation(
+    records: Sequence[Mapping[str, Any]], path: str | os.PathLike[str], title: str | None = None
+) -> None:
+    """T99 relative to nearest-path on the validation episodes, per family and overall, against
+    training steps (records of :class:`~frontier_marl.training.family_validation.
+    FamilyValidator`); 0 is parity, below it the policy travels less."""
+    rows = [r for r in records if "by_family" in r]
+    if not rows:
+        raise ValueError("no family validation records")
+    plt = _pyplot()
+    steps = np.array([r["step"] for r in rows], float)
+    fig, ax = plt.subplots(figsize=(7.0, 3.8))
+    try:
+        for name in rows[0]["by_family"]:
+            values = [100 * r["by_family"][name] for r in rows]
+            ax.plot(steps, values, marker=".", linewidth=0.8, label=name)
+        overall = [100 * r["t99_vs_nearest_path"] for r in rows]
+        ax.plot(steps, overall, color="black", linewidth=2.0, label="all families")
+        ax.axhline(0.0, color="grey", linewidth=0.8)
+        ax.axhline(-5.0, color="green", linewidth=0.8, linestyle="--", label="-5 % (target)")
+        ax.set_xlabel("training steps")
+        ax.set_ylabel("T99 vs nearest-path (%)")
+        ax.set_title(title or "validation: travel to 99 % coverage against nearest-path")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+    finally:
+        plt.close(fig)

@@ -64,18 +64,19 @@ def record_session(
 
 
 def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: int) -> Path:
-    """``RUN/learning_curve.png`` from the run's metrics and validation logs."""
+    """``RUN/learning_curve.png`` from the run's metrics and validation logs (and, for a run
+    validated on map families, ``RUN/validation_t99.png``)."""
     from frontier_marl.training.callbacks import read_metrics
+    from frontier_marl.training.plots import plot_family_validation
     from frontier_marl.training.plots import plot_learning_curve as plot
     from frontier_marl.training.validation import read_validation_log
 
     path = run_dir / "learning_curve.png"
-    plot(
-        read_metrics(run_dir / "metrics.jsonl"),
-        path,
-        title=f"{experiment.name} (seed {experiment.train.seed}, {num_timesteps} steps)",
-        validation=read_validation_log(run_dir),
-    )
+    title = f"{experiment.name} (seed {experiment.train.seed}, {num_timesteps} steps)"
+    validation = read_validation_log(run_dir)
+    plot(read_metrics(run_dir / "metrics.jsonl"), path, title=title, validation=validation)
+    if any("by_family" in record for record in validation):
+        plot_family_validation(validation, run_dir / "validation_t99.png", title=title)
     return path
 
 
