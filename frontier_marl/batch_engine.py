@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import commit_to_previous
-from frontier_marl.core.worlds import SlotArrays, Worlds
+from frontier_marl.core.slots import SlotArrays, commit_to_previous
+from frontier_marl.core.worlds import Worlds
 from frontier_marl.episodes import EpisodeSource, world_params
 from frontier_marl.observations import ObservationEncoder, teammate_rows
 from frontier_marl.rewards import BatchOutcome, OscillationHistory, batch_outcome

@@ -15,7 +15,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 from frontier_marl.checks import (
     check_bool,
@@ -38,18 +38,6 @@ FeatureLayout = Literal["thesis", "explorer"]
 CommitRule = Literal["none", "until-progress", "until-reached"]
 FULL_PATH = "full"
 
-_CENTROIDS = ("absolute", "relative", "distance", "none")
-_MAP_MODES = ("static", "dynamic")
-_GENERATORS = ("random", "rooms")
-_START_CELLS = ("largest-component", "any-free")
-_SENSORS = ("square", "raycast")
-_GAINS = ("size", "unknown")
-_BASES = ("all", "free", "reachable")
-_REWARDS = ("reward1", "reward2", "travel")
-_TEAMMATES = ("none", "positions", "positions+targets")
-_FEATURES = ("thesis", "explorer")
-_COMMITS = ("none", "until-progress", "until-reached")
-
 
 @dataclass(frozen=True)
 class ObservationConfig:
@@ -67,16 +55,10 @@ class ObservationConfig:
         teammates: add a ``teammates`` key to the ``Dict`` observation: the other robots'
             ``positions`` (row, col each, in agent order), or ``positions+targets`` (also the
             cell each is heading to; zeros before its first decision or when idle).
-        features: ``thesis`` (the layout the axes above describe) or ``explorer``: per-slot
-            features that do not depend on the map size (path length, gain, isolation, ...;
-            :mod:`frontier_marl.slot_features`), a ``Dict`` of ``slots`` and ``action_mask``;
-            the axes above are then unused.
-        commit: ``until-progress`` narrows a robot's action mask to the slot of its previous
-            target while its last step revealed no new cell and that target is still offered
-            (the heuristics' livelock rule, docs/calibration.md, for a learned policy);
-            ``until-reached`` keeps it whatever the step revealed, until the robot reaches it or
-            it is no longer offered (a decision picks the next frontier to go to); ``none``
-            (the default) leaves every live slot valid.
+        features: ``thesis`` (the axes above) or ``explorer``: size-independent per-slot
+            features (:mod:`frontier_marl.slot_features`); the axes above are then unused.
+        commit: narrow the action mask to the previous target's slot: ``until-progress``, or
+            ``until-reached``; ``none`` keeps every live slot (docs/environment.md).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -90,10 +72,10 @@ class ObservationConfig:
     commit: CommitRule = "none"
 
     def validate(self) -> None:
-        check_choice("features", self.features, _FEATURES)
-        check_choice("commit", self.commit, _COMMITS)
-        check_choice("centroid", self.centroid, _CENTROIDS)
-        check_choice("teammates", self.teammates, _TEAMMATES)
+        check_choice("features", self.features, get_args(FeatureLayout))
+        check_choice("commit", self.commit, get_args(CommitRule))
+        check_choice("centroid", self.centroid, get_args(CentroidEncoding))
+        check_choice("teammates", self.teammates, get_args(TeammateEncoding))
         for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
             check_bool(name, getattr(self, name))
         if self.centroid == "none" and not self.info_gain:
@@ -160,8 +142,8 @@ class RewardConfig:
     travel_cost: float = -0.02
 
     def validate(self) -> None:
-        check_choice("reward", self.kind, _REWARDS)
-        check_choice("threshold_basis", self.threshold_basis, _BASES)
+        check_choice("reward", self.kind, get_args(RewardKind))
+        check_choice("threshold_basis", self.threshold_basis, get_args(ThresholdBasis))
         check_range("explore_threshold", self.explore_threshold, 0.0, 1.0, low_open=True)
         check_int("max_steps", self.max_steps, 1)
         check_int("no_progress_limit", self.no_progress_limit, 1)
@@ -259,15 +241,15 @@ class EnvConfig:
         check_int("height", self.height, 3, 4096)
         check_int("width", self.width, 3, 4096)
         check_int("n_agents", self.n_agents, 1, 64)
-        check_choice("map_generator", self.map_generator, _GENERATORS)
+        check_choice("map_generator", self.map_generator, get_args(MapGenerator))
         check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
         check_range("obstacle_prob_spread", self.obstacle_prob_spread, 0.0, 0.5)
-        check_choice("start_cells", self.start_cells, _START_CELLS)
+        check_choice("start_cells", self.start_cells, get_args(StartCells))
         if self.map_generator == "rooms" and min(self.height, self.width) < 5:
             raise ValueError(
                 f"map_generator='rooms' needs height and width >= 5, got {self.height}x{self.width}"
             )
-        check_choice("map_mode", self.map_mode, _MAP_MODES)
+        check_choice("map_mode", self.map_mode, get_args(MapMode))
         check_int("map_seed", self.map_seed, 0)
         if self.map_path is not None:
             if not isinstance(self.map_path, str):
@@ -277,15 +259,14 @@ class EnvConfig:
                     "map_mode must be 'static' with map_path (a file holds one fixed layout)"
                 )
         check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
-        check_choice("sensor", self.sensor, _SENSORS)
+        check_choice("sensor", self.sensor, get_args(SensorModel))
         if self.cells_per_step != FULL_PATH:
             check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
         check_int("connectivity", self.connectivity, 4, 8)
-        if self.connectivity not in (4, 8):
-            raise ValueError(f"connectivity must be 4 or 8, got {self.connectivity!r}")
+        check_choice("connectivity", self.connectivity, (4, 8))
         check_int("max_cluster_cells", self.max_cluster_cells, 1)
         check_int("n_slots", self.n_slots, 1, 256)
-        check_choice("gain", self.gain, _GAINS)
+        check_choice("gain", self.gain, get_args(GainModel))
         if not isinstance(self.observation, ObservationConfig):
             raise ValueError("observation must be an ObservationConfig")
         if not isinstance(self.reward, RewardConfig):
@@ -385,7 +366,7 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
         if isinstance(value, RewardConfig):
             reward = value
         else:
-            check_choice("reward", value, _REWARDS)
+            check_choice("reward", value, get_args(RewardKind))
             rew_kw["kind"] = value
     if isinstance(observation, ObservationConfig) and obs_kw:
         observation = dataclasses.replace(observation, **obs_kw)

@@ -17,9 +17,8 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import SlotTable, commit_to_previous
+from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
-from frontier_marl.core.worlds import SlotArrays
 from frontier_marl.episodes import EpisodeSource, world_params
 from frontier_marl.observations import ObservationEncoder, teammate_rows
 from frontier_marl.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome

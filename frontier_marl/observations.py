@@ -26,8 +26,7 @@ import numpy as np
 from gymnasium import spaces
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import SlotTable
-from frontier_marl.core.worlds import SlotArrays
+from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.slot_features import EXPLORER_FEATURES, explorer_features, explorer_space
 
 

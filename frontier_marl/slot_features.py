@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
-from frontier_marl.core.worlds import SlotArrays
+from frontier_marl.core.slots import SlotArrays
 
 CELLS = 32.0  # the length unit of the features, in cells
 EXPLORER_FEATURES = (

@@ -17,6 +17,7 @@ from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.slots import robot_slots
 from frontier_marl.evaluation import GreedyDistance, NearestPath, make_policy
 from frontier_marl.evaluation import benchmark as bench
+from frontier_marl.evaluation import families as map_families
 from frontier_marl.evaluation.benchmark_stats import (
     best_heuristic,
     compare,
@@ -134,16 +135,16 @@ def test_best_heuristic_has_most_successes_then_lowest_t99():
 
 
 def test_families_and_seed_ranges():
-    assert list(bench.FAMILIES) == ["random-20", "random-30", "rooms-32", "rooms-64"]
-    for fam in bench.FAMILIES.values():
+    assert list(map_families.FAMILIES) == ["random-20", "random-30", "rooms-32", "rooms-64"]
+    for fam in map_families.FAMILIES.values():
         held = set(fam.heldout)
         assert not held & set(fam.train[-1000:]) and not held & set(fam.validation)
         assert fam.train.stop <= fam.validation.start and fam.validation.stop <= fam.heldout.start
         assert fam.seeds(3) == [900_000, 900_001, 900_002]
     shapes = {
         name: (c.height, c.width, c.perception_range, c.map_generator, c.map_mode)
-        for name in bench.FAMILIES
-        for c in bench.variant_configs(bench.family(name))
+        for name in map_families.FAMILIES
+        for c in map_families.variant_configs(map_families.family(name))
     }
     assert shapes == {
         "random-20": (20, 20, 3, "random", "dynamic"),
@@ -151,21 +152,23 @@ def test_families_and_seed_ranges():
         "rooms-32": (32, 32, 3, "rooms", "dynamic"),
         "rooms-64": (64, 64, 5, "rooms", "dynamic"),
     }
-    (cfg,) = bench.variant_configs(bench.family("rooms-64"), {"perception_range": 4}, agents=2)
+    (cfg,) = map_families.variant_configs(
+        map_families.family("rooms-64"), {"perception_range": 4}, agents=2
+    )
     assert (cfg.perception_range, cfg.max_cluster_cells, cfg.n_agents) == (4, 10, 2)
-    assert cfg.n_slots == bench.HEURISTIC_SLOTS
+    assert cfg.n_slots == map_families.HEURISTIC_SLOTS
     assert (cfg.reward.explore_threshold, cfg.reward.max_steps) == (0.99, 2 * 64 * 64)
     assert (bench.default_commit(1), bench.default_commit(3)) == ("until-progress", "none")
     with pytest.raises(ValueError, match="unknown family"):
-        bench.family("mazes")
+        map_families.family("mazes")
     with pytest.raises(ValueError, match="episodes"):
-        bench.family("random-20").seeds(0)
+        map_families.family("random-20").seeds(0)
 
 
 @pytest.mark.parametrize("name", ["random-20", "rooms-32"])
 def test_same_maps_and_starts_whatever_the_observation_settings(name):
     """The reset seed alone fixes the true grid and the start cells."""
-    (world,) = bench.variant_configs(bench.family(name), agents=2)
+    (world,) = map_families.variant_configs(map_families.family(name), agents=2)
     variants = [
         {},
         {"n_slots": 4, "centroid": "relative", "sort_by_distance": True},
@@ -173,7 +176,7 @@ def test_same_maps_and_starts_whatever_the_observation_settings(name):
         {"normalize": True, "teammates": "positions", "action_mask": True, "gain": "unknown"},
     ]
     envs = [frontier_marl.parallel_env(config=world.replace(**v)) for v in variants]
-    for seed in bench.family(name).seeds(3):
+    for seed in map_families.family(name).seeds(3):
         grids, starts = [], []
         for env in envs:
             env.reset(seed=seed)
@@ -188,13 +191,13 @@ def test_same_maps_and_starts_whatever_the_observation_settings(name):
 def test_loaded_maps_cycle_and_scale_the_sensor(tmp_path):
     small = tmp_path / "small.txt"
     small.write_text("\n".join(["." * 9] * 6) + "\n")
-    fam = bench.map_family([tmp_path])
+    fam = map_families.map_family([tmp_path])
     assert fam.name == f"map:{tmp_path.name}" and fam.maps == (str(small),)
-    (cfg,) = bench.variant_configs(fam)
+    (cfg,) = map_families.variant_configs(fam)
     assert (cfg.height, cfg.width, cfg.perception_range, cfg.map_mode) == (6, 9, 3, "static")
-    assert bench.loaded_map_range(250, 250) == 35
+    assert map_families.loaded_map_range(250, 250) == 35
     with pytest.raises(ValueError, match="does not exist"):
-        bench.map_family([tmp_path / "nothing.pgm"])
+        map_families.map_family([tmp_path / "nothing.pgm"])
 
 
 # ----------------------------------------------------------------- the command
@@ -291,7 +294,7 @@ def test_cli_shipped_model_keeps_its_observation_settings(tmp_path, capsys):
         ("random-30", "nearest-path"),
     ]
     heuristic, model = rows[0], rows[1]
-    assert (heuristic["n_slots"], model["n_slots"]) == (bench.HEURISTIC_SLOTS, 4)
+    assert (heuristic["n_slots"], model["n_slots"]) == (map_families.HEURISTIC_SLOTS, 4)
     assert model["config"]["normalize"] and not heuristic["config"]["normalize"]
     for key in ("perception_range", "cells_per_step", "max_steps", "explore_threshold"):
         assert model["config"][key] == heuristic["config"][key]

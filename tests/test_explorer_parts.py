@@ -9,8 +9,7 @@ import torch
 
 import frontier_marl
 from frontier_marl.config import make_config
-from frontier_marl.core.slots import SlotTable
-from frontier_marl.core.worlds import SlotArrays
+from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.rewards import StepEvents, step_outcome
 from frontier_marl.slot_features import CELLS, EXPLORER_FEATURES, explorer_features
 
@@ -165,3 +164,20 @@ def test_mixed_vec_env_joins_families_of_different_sizes() -> None:
     assert rewards.shape == (4,) and len(infos) == 4
     with pytest.raises(ValueError, match="same observation space"):
         MixedVecEnv([parts[0], make_batched_vec_env({"config": make_config()}, 1)])
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"families": ("random-20", "nope")}, "train.families: unknown family 'nope'"),
+        ({"families": "rooms-64"}, "train.families must be a list"),
+        ({"families": ("rooms-64",), "vec_env": "supersuit"}, "needs train.vec_env"),
+        ({"policy": "transformer"}, "train.policy must be one of"),
+        ({"vec_env": "ray"}, "train.vec_env must be one of"),
+    ],
+)
+def test_bad_training_settings_are_refused_by_name(settings: dict, message: str) -> None:
+    from frontier_marl.training.experiment import TrainSettings
+
+    with pytest.raises(ValueError, match=message):
+        TrainSettings(**settings)

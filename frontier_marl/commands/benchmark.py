@@ -30,7 +30,7 @@ TEAM_HEURISTICS = ("coordinated-assignment", "utility-discount")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.evaluation.benchmark import DEFAULT_EPISODES, FAMILIES, SPLITS
+    from frontier_marl.evaluation.families import DEFAULT_EPISODES, FAMILIES, SPLITS
 
     parser.add_argument(
         "--families",
@@ -99,6 +99,7 @@ def _names(text: str | None) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from frontier_marl.evaluation import benchmark as bench
+    from frontier_marl.evaluation import families as map_families
     from frontier_marl.evaluation.benchmark_stats import format_table, plot_benchmark
     from frontier_marl.json_files import write_json
 
@@ -107,10 +108,10 @@ def run(args: argparse.Namespace) -> int:
         if args.families is not None and not names:
             raise ValueError("--families must name at least one family")
         if args.families is None and not args.maps:
-            names = list(bench.FAMILIES)
-        families = [bench.family(name) for name in names]
+            names = list(map_families.FAMILIES)
+        families = [map_families.family(name) for name in names]
         if args.maps:
-            families.append(bench.map_family(args.maps))
+            families.append(map_families.map_family(args.maps))
         overrides = parse_set_options(args.overrides)
         policy_names = _names(args.policies)
         if args.policies is None:
@@ -121,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
         policies = bench.contenders(policy_names, commit)
         for fam in families:
             fam.seeds(args.episodes, args.split)
-            bench.variant_configs(fam, overrides, args.agents)
+            map_families.variant_configs(fam, overrides, args.agents)
     except ValueError as exc:
         return fail("benchmark", str(exc))
     start = time.perf_counter()
@@ -136,7 +137,9 @@ def run(args: argparse.Namespace) -> int:
         split=args.split,
     )
     wall = time.perf_counter() - start
-    first = (bench.HELDOUT_SEEDS if args.split == "heldout" else bench.VALIDATION_SEEDS).start
+    first = (
+        map_families.HELDOUT_SEEDS if args.split == "heldout" else map_families.VALIDATION_SEEDS
+    ).start
     split = "held-out" if args.split == "heldout" else "validation"
     title = (
         f"{args.episodes} {split} episodes per family (seeds {first}..."

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.core.frontiers import Clusters
-from frontier_marl.core.slots import SlotTable, robot_slots
-from frontier_marl.core.worlds import FULL_PATH, SlotArrays, WorldParams, Worlds
+from frontier_marl.core.slots import SlotArrays, SlotTable, robot_slots
+from frontier_marl.core.worlds import FULL_PATH, WorldParams, Worlds
 
 __all__ = ["FULL_PATH", "MoveResult", "World", "WorldParams"]
 

@@ -13,7 +13,6 @@ Arrays are indexed ``[world, ...]`` and ``[world, robot, ...]``; read them, neve
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,12 +30,9 @@ from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.movement import walk
 from frontier_marl.core.sensing import Sensor, reveal
-from frontier_marl.core.slots import SlotTable, _robot_slots
+from frontier_marl.core.slots import SlotArrays, _robot_slots
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
-_FIELDS = (
-    "cluster", "valid", "centroid", "target", "distance", "size", "gain", "path_length", "mask"
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -48,64 +44,6 @@ class WorldParams:
     connectivity: int = 8
     max_cluster_cells: int = 0
     gain: str = "size"  # or "unknown"
-
-
-@dataclass(slots=True)
-class SlotArrays:
-    """The slots of many robots: the fields of :class:`~frontier_marl.core.slots.SlotTable`
-    with leading axes, ``(N, K)`` (world, robot) in a batch or ``(M,)`` for M robots."""
-
-    cluster: np.ndarray  # int (N, K, S)
-    valid: np.ndarray  # bool (N, K, S)
-    centroid: np.ndarray  # float (N, K, S, 2)
-    target: np.ndarray  # int (N, K, S, 2)
-    distance: np.ndarray  # float (N, K, S)
-    size: np.ndarray  # int (N, K, S)
-    gain: np.ndarray  # float (N, K, S)
-    path_length: np.ndarray  # int (N, K, S)
-    mask: np.ndarray  # int8 (N, K, S)
-    live: np.ndarray  # int (N, K)
-
-    @classmethod
-    def stack(cls, tables: Sequence[SlotTable]) -> SlotArrays:
-        """The tables of M robots as ``(M, ...)`` arrays."""
-        fields = {name: np.stack([getattr(t, name) for t in tables]) for name in _FIELDS}
-        return cls(**fields, live=np.array([t.live for t in tables], dtype=np.int64))
-
-    def table(self, row: int) -> SlotTable:
-        """Robot ``row``'s :class:`SlotTable` (views) of ``(M, ...)`` arrays."""
-        fields = {name: getattr(self, name)[row] for name in _FIELDS}
-        return SlotTable(**fields, live=int(self.live[row]))
-
-    def world(self, index: int) -> SlotArrays:
-        """The robots of world ``index`` of a batch as ``(K, ...)`` arrays (views)."""
-        fields = {name: getattr(self, name)[index] for name in (*_FIELDS, "live")}
-        return SlotArrays(**fields)
-
-    def rows(self, worlds: np.ndarray | slice) -> SlotArrays:
-        """The robots of ``worlds`` of a batch as ``(M, ...)`` arrays, world after world."""
-        fields = {name: getattr(self, name)[worlds] for name in (*_FIELDS, "live")}
-        count = fields["live"].size
-        return SlotArrays(
-            **{name: value.reshape(count, *value.shape[2:]) for name, value in fields.items()}
-        )
-
-    @classmethod
-    def empty(cls, n_worlds: int, n_agents: int, n_slots: int) -> SlotArrays:
-        """Uninitialised arrays for :meth:`Worlds.slots` to fill."""
-        shape = (n_worlds, n_agents, n_slots)
-        return cls(
-            cluster=np.empty(shape, dtype=np.int64),
-            valid=np.empty(shape, dtype=bool),
-            centroid=np.empty((*shape, 2)),
-            target=np.empty((*shape, 2), dtype=np.int64),
-            distance=np.empty(shape),
-            size=np.empty(shape, dtype=np.int64),
-            gain=np.empty(shape),
-            path_length=np.empty(shape, dtype=np.int64),
-            mask=np.empty(shape, dtype=np.int8),
-            live=np.empty(shape[:2], dtype=np.int64),
-        )
 
 
 class Worlds:

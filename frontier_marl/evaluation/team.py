@@ -102,8 +102,9 @@ class TeamHeuristic(Policy):
         team = [infos[agent] for agent in agents]
         options = self.options(team)
         kept: list[int | None] = [None] * len(team)
-        stalled = not any(info["new_cells"] for info in team)
-        if self.commit == "until-reached" or (self.commit == "until-progress" and stalled):
+        if self.commit == "until-reached" or (
+            self.commit == "until-progress" and not any(info["new_cells"] for info in team)
+        ):
             kept = [previous_target_slot(info) for info in team]
         chosen = self._choose_around(options, kept)
         return {

@@ -94,7 +94,7 @@ class TrainSettings:
             ``slot-scorer`` (the masked, permutation-equivariant Q-network of
             :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; needs
             ``features = "explorer"``).
-        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.benchmark`),
+        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.families`),
             ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
             range; ``[env]`` then sets the observation and reward (not the map). Empty: the
             ``[env]`` world.
@@ -139,20 +139,10 @@ class TrainSettings:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
         if self.policy not in POLICIES:
             raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
-        if not isinstance(self.families, tuple) or not all(
-            isinstance(name, str) for name in self.families
-        ):
-            raise ValueError(
-                f"train.families must be a list of family names, got {self.families!r}"
-            )
         if self.families:
-            from frontier_marl.evaluation.benchmark import family
+            from frontier_marl.evaluation.families import check_families
 
-            for name in self.families:
-                try:
-                    family(name)
-                except ValueError as exc:
-                    raise ValueError(f"train.families: {exc}") from None
+            check_families(self.families, "train.families")
             if self.vec_env != "batched":
                 raise ValueError("train.families needs train.vec_env = 'batched'")
         if self.vec_env not in VEC_ENVS:
@@ -205,7 +195,7 @@ class Experiment:
         """One env config per training family (``[env]`` on each family's world), or the
         ``[env]`` config alone."""
         if self.train.families:
-            from frontier_marl.evaluation.benchmark import family, variant_configs
+            from frontier_marl.evaluation.families import family, variant_configs
 
             return [variant_configs(family(name), self.env)[0] for name in self.train.families]
         kwargs = dict(self.env)

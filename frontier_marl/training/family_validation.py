@@ -16,12 +16,10 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
-from frontier_marl.evaluation.benchmark import (
+from frontier_marl.evaluation.benchmark import Contender, heuristic, run_family
+from frontier_marl.evaluation.families import (
     OBSERVATION_KEYS,
-    Contender,
     family,
-    heuristic,
-    run_family,
     variant_configs,
     world_settings,
 )

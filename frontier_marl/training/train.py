@@ -131,7 +131,7 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
         return make({"config": experiment.env_config()}, settings.n_envs, seed, bootstrap)
     from stable_baselines3.common.vec_env import VecMonitor
 
-    from frontier_marl.evaluation.benchmark import family
+    from frontier_marl.evaluation.families import family
 
     parts = []
     for i, (name, cfg) in enumerate(zip(settings.families, experiment.env_configs(), strict=True)):
