@@ -64,8 +64,8 @@ class ExplorationMDP:
         self.params = world_params(cfg)
         self.source = EpisodeSource(cfg)
         self.world: World | None = None
-        self._slots: list[SlotTable] = []
         self._slot_arrays: SlotArrays | None = None
+        self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
@@ -96,11 +96,14 @@ class ExplorationMDP:
         slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
         targets = np.full((n, 2), -1, dtype=np.int64)
         padding = np.zeros(n, dtype=bool)
-        for agent, (slot, table) in enumerate(zip(slots, self._slots, strict=True)):
-            if slot < table.live:  # live slots come first
-                targets[agent] = table.target[slot]
+        arrays = self._slot_arrays
+        assert arrays is not None
+        for agent, slot in enumerate(slots):
+            live = arrays.live[agent]
+            if slot < live:  # live slots come first
+                targets[agent] = arrays.target[agent, slot]
             else:
-                padding[agent] = table.live > 0
+                padding[agent] = live > 0
         oscillation = self._oscillation.update(targets[None])[0]
         world = self.world
         before = world.travelled.copy()
@@ -173,15 +176,20 @@ class ExplorationMDP:
         assert self.world is not None
         sort = self.cfg.observation.sort_by_distance
         self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
-        self._slots = [self._slot_arrays.table(agent) for agent in range(self.cfg.n_agents)]
+        self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
         """The slot tables the robots observe now (the ones their next actions refer to)."""
-        return list(self._slots)
+        if self._tables is None:
+            arrays = self._slot_arrays
+            assert arrays is not None
+            self._tables = [arrays.table(agent) for agent in range(self.cfg.n_agents)]
+        return list(self._tables)
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
-        return [table.mask for table in self._slots]
+        assert self._slot_arrays is not None
+        return list(self._slot_arrays.mask)
 
     def _observations(
         self, targets: np.ndarray | None, reached: np.ndarray | None
@@ -199,7 +207,7 @@ class ExplorationMDP:
             heading,
         )
         if isinstance(batch, dict):
-            agents = range(len(self._slots))
+            agents = range(self.cfg.n_agents)
             return [{key: value[agent] for key, value in batch.items()} for agent in agents]
         return list(batch)
 

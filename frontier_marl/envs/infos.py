@@ -47,8 +47,8 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
     fraction = world.explored_fraction(mdp.cfg.reward.threshold_basis)
     coverage = world.explored_fraction("reachable")
     travelled = world.travelled.tolist()
-    tables = mdp.slot_tables()
-    n = len(tables)
+    masks = mdp.action_masks()
+    n = len(masks)
     new_cells = [0] * n if result is None else result.move.new_cells.tolist()
     reason = "" if result is None else result.outcome.reason
     common = {"explored_fraction": fraction, "coverage": coverage, "step": mdp.steps}
@@ -56,7 +56,7 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
         StepInfo(
             common,
             new_cells=new_cells[agent],
-            action_mask=tables[agent].mask,
+            action_mask=masks[agent],
             travelled=travelled[agent],
             end_reason=reason,
         )
@@ -73,6 +73,7 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
         paths = result.move.paths
         targets = [None if row < 0 else (row, col) for row, col in result.targets.tolist()]
         padding, oscillation = result.padding.tolist(), result.oscillation.tolist()
+    tables = mdp.slot_tables()
     for agent, info in enumerate(infos):
         info.update(
             slots=tables[agent],
