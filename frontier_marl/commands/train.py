@@ -136,13 +136,19 @@ def run(args: argparse.Namespace) -> int:
     from frontier_marl.training.train import train
 
     cfg = experiment.env_config()
+    settings = experiment.train
     start = "" if checkpoint is None else f", resuming at step {checkpoint.step}"
+    if settings.families:
+        world = f"families {', '.join(settings.families)}, {cfg.map_mode} maps"
+        worlds = f"{settings.n_envs} worlds per family"
+    else:
+        world = f"{cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map"
+        worlds = f"{settings.n_envs} world(s)"
     print(
         f"{experiment.name}: {experiment.description}\n"
-        f"  env: {cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map, "
-        f"reward={cfg.reward.kind}, observation={cfg.observation}\n"
-        f"  {experiment.train.total_timesteps} steps, seed {experiment.train.seed}, "
-        f"{experiment.train.n_envs} env copy(ies){start}\n"
+        f"  env: {world}, reward={cfg.reward.kind}, observation={cfg.observation}\n"
+        f"  {settings.total_timesteps} steps, seed {settings.seed}, {worlds} "
+        f"({settings.vec_env}){start}\n"
         f"  run folder: {run_dir}"
     )
     try:
