@@ -23,7 +23,28 @@ from frontier_marl.rewards import REASONS
 from frontier_marl.training.vec_env import END_REASON_KEY, TRUNCATED_KEY, copy_seeds
 
 
-class BatchedVecEnv(VecEnv):
+class MaskedVecEnv(VecEnv):
+    """An SB3 ``VecEnv`` whose only env method is ``action_masks`` (what sb3-contrib's
+    MaskablePPO calls) and whose envs have no attributes to set."""
+
+    def action_masks(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+        raise AttributeError(f"{type(self).__name__} has no per-env attributes to set")
+
+    def env_method(
+        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
+    ) -> list[Any]:
+        if method_name != "action_masks":
+            raise AttributeError(f"{type(self).__name__} has no env method {method_name!r}")
+        return list(self.action_masks()[env_indices(indices, self.num_envs)])
+
+    def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
+        return [False] * len(env_indices(indices, self.num_envs))
+
+
+class BatchedVecEnv(MaskedVecEnv):
     """``n_envs`` worlds of K robots as an SB3 ``VecEnv`` of ``n_envs x K`` slots."""
 
     def __init__(
@@ -87,19 +108,6 @@ class BatchedVecEnv(VecEnv):
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
         return [getattr(self.env, attr_name, None)] * len(env_indices(indices, self.num_envs))
 
-    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
-        raise AttributeError(f"{type(self).__name__} has no per-env attributes to set")
-
-    def env_method(
-        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
-    ) -> list[Any]:
-        if method_name != "action_masks":
-            raise AttributeError(f"{type(self).__name__} has no env method {method_name!r}")
-        return list(self.action_masks()[env_indices(indices, self.num_envs)])
-
-    def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
-        return [False] * len(env_indices(indices, self.num_envs))
-
 
 def env_indices(indices: Any, num_envs: int) -> list[int]:
     """SB3's ``indices`` argument (None, an int or an iterable) as a list."""
@@ -134,7 +142,7 @@ def make_batched_vec_env(
         return VecMonitor(vec)
 
 
-class MixedVecEnv(VecEnv):
+class MixedVecEnv(MaskedVecEnv):
     """Several SB3 vector envs of one observation space side by side (e.g. one batch per map
     family, whose grids differ in size): slots of the first, then of the second, ..."""
 
@@ -182,19 +190,6 @@ class MixedVecEnv(VecEnv):
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
         values = [value for part in self.parts for value in part.get_attr(attr_name)]
         return [values[i] for i in env_indices(indices, self.num_envs)]
-
-    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
-        raise AttributeError(f"{type(self).__name__} has no per-env attributes to set")
-
-    def env_method(
-        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
-    ) -> list[Any]:
-        if method_name != "action_masks":
-            raise AttributeError(f"{type(self).__name__} has no env method {method_name!r}")
-        return list(self.action_masks()[env_indices(indices, self.num_envs)])
-
-    def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
-        return [False] * len(env_indices(indices, self.num_envs))
 
     @staticmethod
     def _join(observations: list[Any]) -> Any:
