@@ -79,7 +79,8 @@ class BatchMDP:
     # ------------------------------------------------------------------ transition
     def step(self, actions: np.ndarray, active: np.ndarray) -> None:
         """One decision per robot of the ``active`` worlds (bool (N,)): ``actions`` (N, K)
-        holds valid slot indices (checked by the caller). Inactive worlds do not change."""
+        holds valid slot indices (checked by the caller). Inactive worlds (ended, about to be
+        reset) do not move and get no reward or end flag."""
         slots = self.slots
         live = slots.live
         chosen = actions < live  # live slots come first
