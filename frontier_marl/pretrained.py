@@ -4,7 +4,7 @@
 
 Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with its
 ``model.json`` metadata (env config, observation layout, training run). How each was trained is
-in docs/results.md.
+in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``).
 """
 
 from __future__ import annotations
@@ -14,6 +14,10 @@ from pathlib import Path
 
 #: name -> one-line description
 PRETRAINED: dict[str, str] = {
+    "explorer": "the learned frontier selector (docs/beyond-the-thesis.md): a masked, "
+    "permutation-equivariant slot scorer on size-independent slot features, trained on the "
+    "four benchmark map families by `frontier-marl train explorer` (seed 0); the "
+    "best-validated policy (step 200,000)",
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
     "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
     "frontier-marl reproduce run, the seed whose protocol score is the median of the three",

@@ -181,3 +181,23 @@ def test_bad_training_settings_are_refused_by_name(settings: dict, message: str)
 
     with pytest.raises(ValueError, match=message):
         TrainSettings(**settings)
+
+
+def test_the_shipped_explorer_acts_on_every_family_and_a_floor_plan_size(tmp_path) -> None:
+    """`explorer` by name: one model for 20x20 to 64x64 (and a 128x128 example map)."""
+    import json
+
+    from frontier_marl.cli import main
+    from frontier_marl.pretrained import pretrained_model_dir
+
+    meta = json.loads((pretrained_model_dir("explorer") / "model.json").read_text())
+    assert meta["observation_layout"]["features"] == "explorer"
+    out = tmp_path / "bench.json"
+    argv = ["benchmark", "--policies", "explorer", "--episodes", "1", "--split", "validation"]
+    argv += ["--families", "random-20,random-30,rooms-32,rooms-64"]
+    assert main([*argv, "--map", "rooms-128", "--json", str(out), "--no-progress"]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert {row["family"] for row in rows} == {
+        "random-20", "random-30", "rooms-32", "rooms-64", "map:rooms-128"
+    }  # fmt: skip
+    assert all(row["success"] == 1 for row in rows)
