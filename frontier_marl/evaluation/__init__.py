@@ -7,7 +7,7 @@
   :mod:`~frontier_marl.evaluation.heuristics` and :mod:`~frontier_marl.evaluation.team`: the
   heuristics, by name in :mod:`~frontier_marl.evaluation.registry`;
 * :mod:`~frontier_marl.evaluation.plots`: result figures;
-* :mod:`~frontier_marl.evaluation.benchmark` and
+* :mod:`~frontier_marl.evaluation.families`, :mod:`~frontier_marl.evaluation.benchmark` and
   :mod:`~frontier_marl.evaluation.benchmark_stats`: the exploration benchmark (map families,
   T99/T90, the paired difference to the best heuristic; docs/benchmark.md).
 """
