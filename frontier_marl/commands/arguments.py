@@ -84,6 +84,13 @@ def parse_set_options(items: Sequence[str] | None) -> dict[str, Any]:
     return out
 
 
+def add_set_argument(parser: argparse.ArgumentParser, help_text: str) -> None:
+    """The repeatable ``--set KEY=VALUE`` option (values in ``args.overrides``)."""
+    parser.add_argument(
+        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE", help=help_text
+    )
+
+
 def add_env_arguments(parser: argparse.ArgumentParser) -> None:
     """``--preset --map --map-generator --map-mode --seed --agents --set`` (shared by
     ``baselines`` and ``gif``)."""
@@ -128,14 +135,9 @@ def add_env_arguments(parser: argparse.ArgumentParser) -> None:
         default=1,
         help="robots sharing one belief (default: %(default)s)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="any other env parameter, e.g. --set cells_per_step=full "
-        "--set sensor=raycast (repeatable)",
+    add_set_argument(
+        parser,
+        "any other env parameter, e.g. --set cells_per_step=full --set sensor=raycast (repeatable)",
     )
 
 

@@ -21,7 +21,12 @@ import sys
 import time
 from pathlib import Path
 
-from frontier_marl.commands.arguments import fail, parse_set_options, positive_int
+from frontier_marl.commands.arguments import (
+    add_set_argument,
+    fail,
+    parse_set_options,
+    positive_int,
+)
 
 #: The default heuristics: the thesis's two, cost-utility and nearest-path; teams add the joint
 #: ones.
@@ -76,13 +81,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the heuristics' commit rule; auto (the default): until-progress with one robot "
         "(it prevents livelocks), none with a team (docs/benchmark.md)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="an env parameter for every family and policy, e.g. --set perception_range=4 "
+    add_set_argument(
+        parser,
+        "an env parameter for every family and policy, e.g. --set perception_range=4 "
         "--set cells_per_step=full (repeatable)",
     )
     parser.add_argument("--json", type=Path, default=None, metavar="FILE", help="write the rows")

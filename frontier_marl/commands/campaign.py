@@ -33,7 +33,7 @@ def _positive_float(text: str) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.arguments import int_list, positive_int
+    from frontier_marl.commands.arguments import add_set_argument, int_list, positive_int
 
     parser.add_argument(
         "--configs",
@@ -90,13 +90,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="K",
         help="at most K trials at once (default: as many as the CPUs allow)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a config value in every experiment, as in "
+    add_set_argument(
+        parser,
+        "override a config value in every experiment, as in "
         "'frontier-marl train --set' (repeatable)",
     )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")

@@ -24,7 +24,7 @@ from frontier_marl.config import PRESETS
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.arguments import non_negative_int, positive_int
+    from frontier_marl.commands.arguments import add_set_argument, non_negative_int, positive_int
 
     parser.add_argument(
         "model",
@@ -63,14 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="robots sharing the belief; each acts with the shared-parameter "
         "model (default: as trained)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="any other env parameter (repeatable)",
-    )
+    add_set_argument(parser, "any other env parameter (repeatable)")
     parser.add_argument(
         "--heuristics",
         default="greedy-distance",

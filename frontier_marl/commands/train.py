@@ -22,7 +22,7 @@ from typing import Any
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.commands.arguments import non_negative_int, positive_int
+    from frontier_marl.commands.arguments import add_set_argument, non_negative_int, positive_int
 
     parser.add_argument(
         "config",
@@ -61,13 +61,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="continue a run from a checkpoint folder or a run's newest "
         "checkpoint (step count and replay buffer included)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a config value: env.KEY, dqn.KEY or train.KEY "
+    add_set_argument(
+        parser,
+        "override a config value: env.KEY, dqn.KEY or train.KEY "
         "(a bare KEY goes to the section that has it); repeatable",
     )
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
