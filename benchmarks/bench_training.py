@@ -6,13 +6,12 @@
 
 Runs the real training loop (``frontier_marl.training.train.train``, no evaluation, no
 checkpoints, the SuperSuit pipeline: ``train.vec_env=supersuit``; the batched env has its own
-benchmark, ``bench_vector_env.py``) and times, inside it, the env (the FrontierParallelEnv step itself), the SuperSuit
-and SB3 vector layers above it, and the DQN gradient steps; the rest is SB3's collection loop
-(action selection, replay buffer, logging). ``--stages`` also times the parts of a decision
-step (movement and sensing, frontier clustering and ``scipy.ndimage.label``, slots,
-observation, reward table, info) and the episode resets. Wall and CPU times are both
-reported: on a shared machine the CPU time is the steadier number. Run one benchmark at a time.
-"""
+benchmark, ``bench_vector_env.py``) and times, inside it, the env (the FrontierParallelEnv step
+itself), the SuperSuit and SB3 vector layers above it, and the DQN gradient steps; the rest is
+SB3's collection loop (action selection, replay buffer, logging). ``--stages`` also times the
+parts of a decision step (movement and sensing, frontier clustering and ``scipy.ndimage.label``,
+slots, observation, reward table, info) and the episode resets. Wall and CPU times are both
+reported: on a shared machine the CPU time is the steadier number. Run one benchmark at a time."""
 
 from __future__ import annotations
 

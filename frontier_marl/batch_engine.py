@@ -18,7 +18,7 @@ from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.episodes import EpisodeSource, world_params
-from frontier_marl.observations import ObservationEncoder, teammate_rows
+from frontier_marl.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.rewards import BatchOutcome, OscillationHistory, batch_outcome
 
 Observations = np.ndarray | dict[str, np.ndarray]
@@ -155,7 +155,7 @@ class BatchMDP:
         positions = self.worlds.positions[worlds].astype(np.float64)
         if layout == "positions":
             return teammate_rows(positions)
-        heading = np.maximum(self.heading[worlds], 0)  # zeros where none
+        heading = observed_heading(self.heading[worlds], self.cfg.observation.features)
         return teammate_rows(np.concatenate([positions, heading], axis=2))
 
     def explored_fraction(self, basis: str) -> np.ndarray:

@@ -20,7 +20,7 @@ from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
 from frontier_marl.episodes import EpisodeSource, world_params
-from frontier_marl.observations import ObservationEncoder, teammate_rows
+from frontier_marl.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
 
 Observation = np.ndarray | dict[str, np.ndarray]
@@ -220,11 +220,13 @@ class ExplorationMDP:
         return np.where(going[:, None], targets, -1)
 
     def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
-        """(N, 2) positions, or (N, 4) positions and current targets (zeros where a robot has
-        none: before its first decision, idle, or on its target); None if not observed."""
+        """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:
+        before its first decision, idle, or on its target, see :func:`observed_heading`); None
+        if not observed."""
         layout = self.cfg.observation.teammates
         if layout == "none":
             return None
         if layout == "positions":
             return positions.astype(np.float64)
-        return np.concatenate([positions, np.maximum(heading, 0)], axis=1).astype(np.float64)
+        heading = observed_heading(heading, self.cfg.observation.features)
+        return np.concatenate([positions, heading], axis=1).astype(np.float64)

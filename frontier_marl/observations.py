@@ -27,7 +27,13 @@ from gymnasium import spaces
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable
-from frontier_marl.slot_features import EXPLORER_FEATURES, explorer_features, explorer_space
+from frontier_marl.slot_features import (
+    EXPLORER_FEATURES,
+    TEAM_FEATURES,
+    explorer_features,
+    explorer_space,
+    team_features,
+)
 
 
 class ObservationEncoder:
@@ -46,8 +52,9 @@ class ObservationEncoder:
         self.normalize = obs.normalize
         self.features = obs.features
         if self.features == "explorer":
-            self.features_per_slot = len(EXPLORER_FEATURES)
-            self.space: spaces.Space[Any] = explorer_space(self.n_slots)
+            team = len(TEAM_FEATURES) if self.teammates != "none" else 0
+            self.features_per_slot = len(EXPLORER_FEATURES) + team
+            self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
         height, width = cfg.height, cfg.width
         cells = cfg.max_cluster_cells
@@ -132,10 +139,14 @@ class ObservationEncoder:
         if self.features == "explorer":
             if heading is None:
                 heading = np.full_like(positions, -1)
-            return {
-                "slots": explorer_features(slots, positions, heading),
-                "action_mask": np.array(slots.mask, dtype=np.int8),
-            }
+            features = explorer_features(slots, positions, heading)
+            if self.teammates != "none":
+                if teammates is None:
+                    raise ValueError("this layout observes teammates: pass their rows")
+                width = 4 if self.teammates == "positions+targets" else 2
+                rows = np.asarray(teammates, dtype=np.float64).reshape(len(positions), -1, width)
+                features = np.concatenate([features, team_features(slots, rows)], axis=-1)
+            return {"slots": features, "action_mask": np.array(slots.mask, dtype=np.int8)}
         dtype = np.float64 if self.normalize else np.float32  # normalize in float64
         count = len(positions)
         features = np.zeros((count, self.n_slots, self.features_per_slot), dtype=dtype)
@@ -172,6 +183,12 @@ class ObservationEncoder:
             scale = np.tile(self._position_scale, teammates.shape[1] // 2)
             out["teammates"] = (teammates / scale).astype(np.float32)
         return out
+
+
+def observed_heading(heading: np.ndarray, features: str) -> np.ndarray:
+    """The teammates' targets as observed: zeros where a robot heads nowhere in the thesis
+    layout (its documented encoding), row -1 kept in the explorer layout."""
+    return heading if features == "explorer" else np.maximum(heading, 0)
 
 
 def teammate_rows(table: np.ndarray) -> np.ndarray:

@@ -14,6 +14,14 @@ same features on a 20x20 grid and on a 64x64 floor plan. Per slot, in order
 ``extra_path``  ``path`` minus the shortest ``path`` of all slots (0 for the nearest)
 ``current``     1 if the slot's target is the cell the robot is heading to
 ``live``        the number of live slots / n_slots (the same on every slot)
+
+With teammates observed (``teammates`` other than ``none``), three more per slot
+(:data:`TEAM_FEATURES`), whatever the team's size:
+
+``mate_distance``         Euclidean distance from the nearest teammate to the slot's target
+``mate_heading``          1 if a teammate heads to the slot's target (``positions+targets``)
+``mate_target_distance``  distance from the target to the nearest teammate's target, capped at
+                          :data:`FAR` (also when no teammate heads anywhere)
 """
 
 from __future__ import annotations
@@ -28,14 +36,16 @@ EXPLORER_FEATURES = (
     "path", "distance", "d_row", "d_col", "size", "gain", "isolation", "extra_path", "current",
     "live",
 )  # fmt: skip
+TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
+FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
 _BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
 
 
-def explorer_space(n_slots: int) -> spaces.Dict:
+def explorer_space(n_slots: int, n_features: int = len(EXPLORER_FEATURES)) -> spaces.Dict:
     """The explorer layout's observation space (the same for every map size)."""
     return spaces.Dict(
         {
-            "slots": spaces.Box(-_BOUND, _BOUND, (n_slots, len(EXPLORER_FEATURES)), np.float32),
+            "slots": spaces.Box(-_BOUND, _BOUND, (n_slots, n_features), np.float32),
             "action_mask": spaces.Box(0, 1, (n_slots,), dtype=np.int8),
         }
     )
@@ -73,3 +83,23 @@ def explorer_features(slots: SlotArrays, positions: np.ndarray, heading: np.ndar
     )
     features[~valid] = 0.0
     return features.astype(np.float32).reshape(count, n_slots, len(EXPLORER_FEATURES))
+
+
+def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:
+    """(M, n_slots, 3) :data:`TEAM_FEATURES` of M robots: ``teammates`` (M, T, 2) positions or
+    (M, T, 4) positions and targets (row -1: heading nowhere) of each robot's T teammates."""
+    target = slots.target.astype(np.float64)  # (M, S, 2)
+    positions = teammates[:, None, :, 0:2]  # (M, 1, T, 2)
+    mate_distance = np.linalg.norm(target[:, :, None, :] - positions, axis=-1).min(axis=2)
+    heading = np.zeros_like(mate_distance)
+    near = np.full_like(mate_distance, FAR)
+    if teammates.shape[-1] == 4:
+        goals = teammates[:, None, :, 2:4]
+        going = goals[..., 0] >= 0  # (M, 1, T)
+        apart = np.linalg.norm(target[:, :, None, :] - goals, axis=-1)  # (M, S, T)
+        heading = ((apart == 0) & going).any(axis=2).astype(np.float64)
+        nearest = np.where(going, apart, np.inf).min(axis=2) / CELLS
+        near = np.minimum(nearest, FAR)
+    features = np.stack([mate_distance / CELLS, heading, near], axis=-1)
+    features[~slots.valid] = 0.0
+    return features.astype(np.float32)

@@ -131,6 +131,22 @@ def test_best_heuristic_has_most_successes_then_lowest_t99():
     assert "80.0 ± 0.0*" in table and "best" in table
 
 
+def test_teams_are_also_compared_by_makespan():
+    rows = [_row("a", [100, 105]), _row("b", [110, 100]), _row("m", [90, 90], heuristic=False)]
+    spans = {"a": [60, 50], "b": [40, 50], "m": [30, 45]}  # b: best makespan, a: best T99
+    for row in rows:
+        row["agents"] = 2
+        row["makespan99_mean"] = float(np.mean(spans[row["policy"]]))
+        row.update(makespan99_std=0.0, overlap_mean=0.0, overlap_std=0.0)
+        for entry, span in zip(row["per_episode"], spans[row["policy"]], strict=True):
+            entry["makespan99"] = span
+    compare(rows)
+    assert {r["best_heuristic"] for r in rows} == {"a"}
+    assert {r["best_heuristic_makespan"] for r in rows} == {"b"}
+    assert rows[2]["makespan_vs_best"]["mean"] == pytest.approx((30 / 40 - 1 + 45 / 50 - 1) / 2)
+    assert "makespan vs best" in format_table(rows)
+
+
 # ----------------------------------------------------------------- families and episodes
 
 
@@ -240,6 +256,7 @@ def test_cli_team_adds_makespan_and_overlap(tmp_path, capsys):
         assert row["agents"] == 2 and row["config"]["perception_range"] == 2
         assert row["makespan99_mean"] < row["t99_mean"]
         assert row["overlap_mean"] >= 0
+        assert row["best_heuristic_makespan"] in ("nearest-path", "coordinated-assignment")
 
 
 @pytest.mark.parametrize(

@@ -47,6 +47,33 @@ def test_explorer_features_on_a_hand_made_table() -> None:
     assert not features[2:].any()  # padding slots are zeros
 
 
+def test_team_features_on_a_hand_made_table() -> None:
+    from frontier_marl.slot_features import FAR, TEAM_FEATURES, team_features
+
+    table = _table([(0, 4), (3, 0)], [6, 3])
+    slots = SlotArrays.stack([table])
+    # two teammates: at (0, 0) heading to (3, 0); at (0, 8) heading nowhere
+    mates = np.array([[[0, 0, 3, 0], [0, 8, -1, -1]]], dtype=float)
+    features = team_features(slots, mates)[0]
+    assert features.shape == (4, len(TEAM_FEATURES))
+    assert features[:, 0].tolist() == pytest.approx([4 / CELLS, 3 / CELLS, 0, 0])  # nearest
+    assert features[:, 1].tolist() == [0, 1, 0, 0]  # a teammate heads to slot 1's target
+    assert features[:, 2].tolist() == pytest.approx([5 / CELLS, 0, 0, 0])
+    positions_only = team_features(slots, mates[..., :2])[0]
+    assert positions_only[:, 1].tolist() == [0, 0, 0, 0]
+    assert positions_only[:2, 2].tolist() == [FAR, FAR]  # no teammate target known
+
+
+def test_team_explorer_observation_does_not_depend_on_the_team_size() -> None:
+    kwargs = {**EXPLORER, "teammates": "positions+targets", "preset": "rooms-32"}
+    spaces = [frontier_marl.parallel_env(n_agents=k, **kwargs).observation_space("robot_0")
+              for k in (2, 4, 8)]  # fmt: skip
+    assert spaces[0] == spaces[1] == spaces[2]
+    assert spaces[0]["slots"].shape == (6, len(EXPLORER_FEATURES) + 3)
+    one = frontier_marl.parallel_env(preset="rooms-32", **EXPLORER).observation_space("robot_0")
+    assert one["slots"].shape == (6, len(EXPLORER_FEATURES))  # the one-robot layout is kept
+
+
 def test_explorer_observation_does_not_depend_on_the_map_size() -> None:
     small = frontier_marl.parallel_env(preset="thesis-20x20", **EXPLORER)
     large = frontier_marl.parallel_env(preset="rooms-32", height=64, width=64, **EXPLORER)

@@ -55,7 +55,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--policies",
         default=None,
-        help="comma-separated heuristic names and model names or paths (default: "
+        help="comma-separated heuristic names, lookahead-oracle (one robot; it reads the true "
+        "map) and model names or paths (default: "
         f"{','.join(HEURISTICS)}, plus {','.join(TEAM_HEURISTICS)} with --agents > 1)",
     )
     parser.add_argument(
@@ -121,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError("--policies must name at least one policy")
         commit = bench.default_commit(args.agents) if args.commit == "auto" else args.commit
         policies = bench.contenders(policy_names, commit)
+        if args.agents > 1 and bench.ORACLE in policy_names:
+            raise ValueError(f"{bench.ORACLE} drives one robot; drop it or use --agents 1")
         for fam in families:
             fam.seeds(args.episodes, args.split)
             map_families.variant_configs(fam, overrides, args.agents)

@@ -121,6 +121,15 @@ class World:
         return self._views["start_region"]
 
     @property
+    def batch(self) -> Worlds:
+        """The batch this world belongs to (its state is row :attr:`index` of the arrays)."""
+        return self._worlds
+
+    @property
+    def index(self) -> int:
+        return self._index
+
+    @property
     def n_agents(self) -> int:
         return self._worlds.n_agents
 

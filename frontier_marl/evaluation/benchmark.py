@@ -41,6 +41,8 @@ from frontier_marl.evaluation.families import (
 from frontier_marl.evaluation.policies import Policy
 from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
 
+ORACLE = "lookahead-oracle"
+
 
 @dataclass
 class Contender:
@@ -93,8 +95,17 @@ def model(name: str) -> Contender:
     return Contender(label, False, lambda: ModelPolicy(loaded.model, name=label), config)
 
 
+def oracle() -> Contender:
+    """``lookahead-oracle`` (:mod:`frontier_marl.evaluation.lookahead`): it reads the true map,
+    so it is reported beside the others but never counts as the best heuristic."""
+    from frontier_marl.evaluation.lookahead import LookaheadOracle
+
+    return Contender(LookaheadOracle.name, False, LookaheadOracle, lambda cfg: cfg)
+
+
 def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Contender]:
-    """Heuristics by name and models by name or path; ValueError for anything else."""
+    """Heuristics by name, ``lookahead-oracle`` and models by name or path; ValueError for
+    anything else."""
     from frontier_marl.evaluation.registry import POLICIES
     from frontier_marl.pretrained import PRETRAINED
 
@@ -102,12 +113,14 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
     for name in names:
         if name in POLICIES:
             out.append(heuristic(name, commit))
+        elif name == ORACLE:
+            out.append(oracle())
         elif name in PRETRAINED or Path(name).exists():
             out.append(model(name))
         else:
             raise ValueError(
-                f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), a shipped "
-                f"model ({', '.join(PRETRAINED)}), nor a model file or run folder"
+                f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), {ORACLE}, "
+                f"a shipped model ({', '.join(PRETRAINED)}), nor a model file or run folder"
             )
     return out
 

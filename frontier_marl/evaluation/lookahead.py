@@ -1,0 +1,155 @@
+"""A privileged reference: one-step lookahead on the true map, finished by nearest-path.
+
+For each candidate target of one robot, :func:`lookahead_costs` copies the robot's world into a
+batch of simulations (one per candidate), walks the robot to that target, then lets
+nearest-path finish the map, and returns the cells each simulation travelled until the coverage
+level. The simulations sense the true map, so they know what the robot does not: which
+frontier will be cleared on the way, which room is a dead end. Choosing the cheapest candidate
+is a rollout policy on nearest-path (Bertsekas's rollout: one step of policy improvement).
+:class:`LookaheadOracle` is that choice as a benchmark contender
+(``lookahead-oracle``): it reads the true map, so it is a bound on what choosing among the same
+clusters can gain, not a heuristic; :mod:`frontier_marl.training.imitation` labels decisions
+with its costs for a student that sees only its own observation.
+
+The base policy of the simulations keeps a target while it is still a frontier cell and then
+picks the nearest cluster by known-free path (ties: nearest centroid), one cell per move.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.core.compiled import compiled
+from frontier_marl.core.grid import FREE, UNKNOWN
+from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.worlds import Worlds
+from frontier_marl.evaluation.policies import HeuristicPolicy, Info, first_by, slot_table
+
+_COPIED = ("true", "belief", "positions", "seen", "travelled", "start_region")
+_COPIED_SCALARS = ("start_region_size", "true_free")
+ROLLOUT_SLOTS = 256  # the base policy sees every reachable cluster, as the heuristics do
+
+
+def copy_world(source: Worlds, index: int, target: Worlds, rows: np.ndarray) -> None:
+    """World ``index`` of ``source`` into worlds ``rows`` of ``target`` (same shape, robots and
+    parameters); their plans and targets are cleared."""
+    for name in _COPIED:
+        getattr(target, name)[rows] = getattr(source, name)[index]
+    for name in _COPIED_SCALARS:
+        getattr(target, name)[rows] = getattr(source, name)[index]
+    target.plan_meta[rows] = -1
+    target.goals[rows] = -1
+    target.version[rows] += 1
+
+
+@compiled
+def _still_frontier(belief: np.ndarray, goals: np.ndarray, worlds: np.ndarray) -> np.ndarray:
+    """Per listed world: robot 0's goal is a free cell with an unknown 4-neighbour."""
+    height, width = belief.shape[1], belief.shape[2]
+    out = np.zeros(len(worlds), dtype=np.bool_)
+    for m in range(len(worlds)):
+        n = worlds[m]
+        r, c = goals[n, 0, 0], goals[n, 0, 1]
+        if r < 0 or belief[n, r, c] != FREE:
+            continue
+        out[m] = (
+            (r > 0 and belief[n, r - 1, c] == UNKNOWN)
+            or (r + 1 < height and belief[n, r + 1, c] == UNKNOWN)
+            or (c > 0 and belief[n, r, c - 1] == UNKNOWN)
+            or (c + 1 < width and belief[n, r, c + 1] == UNKNOWN)
+        )
+    return out
+
+
+def _nearest_path(slots: SlotArrays, world: int) -> np.ndarray | None:
+    """Robot 0's nearest live slot target by path length (ties: centroid distance)."""
+    valid = slots.valid[world, 0]
+    if not valid.any():
+        return None
+    live = np.flatnonzero(valid)
+    order = np.lexsort((slots.distance[world, 0, live], slots.path_length[world, 0, live]))
+    return slots.target[world, 0, live[order[0]]]
+
+
+def lookahead_costs(
+    source: Worlds,
+    index: int,
+    targets: np.ndarray,
+    coverage: float,
+    max_cells: int,
+) -> np.ndarray:
+    """Cells travelled by robot 0 of world ``index`` until ``coverage`` of the reachable free
+    region is known, if it first walks to ``targets[m]`` (M, 2) and nearest-path finishes;
+    ``max_cells`` caps each simulation (a simulation that stalls costs ``max_cells``)."""
+    if source.n_agents != 1:
+        raise ValueError(f"the lookahead teacher drives one robot, got {source.n_agents}")
+    targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
+    count = len(targets)
+    # nearest-path reads no gain: the cheapest gain saves counting unknown cells
+    sims = Worlds(source.shape, count, 1, replace(source.params, gain="size"))
+    copy_world(source, index, sims, np.arange(count))
+    start = int(source.travelled[index, 0])
+    sims.goals[:, 0] = targets
+    slots = SlotArrays.empty(count, 1, ROLLOUT_SLOTS)
+    done = np.zeros(count, dtype=bool)
+    cost = np.full(count, max_cells, dtype=np.int64)
+    while True:
+        covered = sims.explored_fraction("reachable") >= coverage
+        walked = sims.travelled[:, 0] - start
+        finished = ~done & (covered | (walked >= max_cells))
+        cost[finished & covered] = walked[finished & covered]
+        done |= finished
+        if done.all():
+            return cost
+        active = np.flatnonzero(~done)
+        keep = _still_frontier(sims.belief, sims.goals, active) & ~sims.reached[active, 0]
+        deciding = active[~keep]
+        if len(deciding):
+            sims.slots(slots, deciding, False)
+            for world in deciding.tolist():
+                goal = _nearest_path(slots, world)
+                if goal is None:  # nothing reachable is left to explore: it cannot finish
+                    done[world] = True
+                else:
+                    sims.goals[world, 0] = goal
+        moving = np.zeros(count, dtype=bool)
+        moving[~done] = True
+        sims.reached[:] = False
+        sims.move(sims.goals, moving)
+
+
+class LookaheadOracle(HeuristicPolicy):
+    """The cheapest live slot by :func:`lookahead_costs` (ties: nearest path, then nearest
+    centroid), kept until reached (``commit = "until-reached"``). One robot only; it reads
+    the attached env's world, true map included, and its coverage level
+    (``explore_threshold`` of the reachable free cells)."""
+
+    name = "lookahead-oracle"
+
+    def __init__(self) -> None:
+        super().__init__("until-reached")
+        self._env: Any = None
+
+    def attach(self, env: Any) -> None:
+        agents = len(getattr(env, "possible_agents", ["robot_0"]))
+        if agents != 1:
+            raise ValueError(f"lookahead-oracle drives one robot, the env has {agents}")
+        self._env = env
+
+    def choose(self, info: Info) -> int:
+        table = slot_table(info)
+        if table.live <= 1:
+            return 0
+        if self._env is None:
+            raise RuntimeError("lookahead-oracle needs attach(env) before it acts")
+        world = self._env.world
+        height, width = world.shape
+        live = table.live
+        coverage = self._env.config.reward.explore_threshold
+        costs = lookahead_costs(
+            world.batch, world.index, table.target[:live], coverage, 4 * height * width
+        )
+        return first_by(costs, table.path_length[:live], table.distance[:live])

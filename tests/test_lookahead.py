@@ -1,0 +1,112 @@
+"""The lookahead oracle (evaluation/lookahead.py) and the imitation tools built on it
+(training/imitation.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from frontier_marl.core.sensing import make_sensor
+from frontier_marl.core.world import World, WorldParams
+from frontier_marl.evaluation.lookahead import LookaheadOracle, lookahead_costs
+
+
+def _corridor() -> World:
+    """A 13-cell corridor (columns 1..13 of row 1), the robot at column 4, sensor range 1."""
+    grid = np.ones((3, 15), dtype=bool)
+    grid[1, 1:14] = False
+    return World(grid, np.array([[1, 4]]), WorldParams(make_sensor("square", 1), 1))
+
+
+def test_lookahead_costs_on_a_corridor_with_known_answers() -> None:
+    world = _corridor()
+    belief, positions = world.belief.copy(), world.positions.copy()
+    # Left first: (1,3), (1,2), (1,1) sees the end wall, then right to (1,12): 3 + 11 cells.
+    # Right first: out to (1,13) (9 cells), back to (1,2), where column 1 becomes known: 11.
+    costs = lookahead_costs(world.batch, world.index, np.array([[1, 3], [1, 5]]), 0.99, 100)
+    assert costs.tolist() == [14, 20]
+    # the simulations ran on copies: the world itself has not moved or sensed
+    assert np.array_equal(world.belief, belief)
+    assert np.array_equal(world.positions, positions)
+    assert world.travelled.tolist() == [0]
+
+
+def test_lookahead_costs_cap_a_simulation_that_cannot_finish() -> None:
+    world = _corridor()
+    # a coverage above 1 is never reached: every simulation stops at the cap (or earlier,
+    # with nothing left to explore, and then costs the cap as well)
+    costs = lookahead_costs(world.batch, world.index, np.array([[1, 3]]), 1.5, 30)
+    assert costs.tolist() == [30]
+
+
+def test_lookahead_costs_need_one_robot() -> None:
+    grid = np.zeros((6, 6), dtype=bool)
+    world = World(grid, np.array([[0, 0], [5, 5]]), WorldParams(make_sensor("square", 1), 1))
+    with pytest.raises(ValueError, match="one robot"):
+        lookahead_costs(world.batch, world.index, np.array([[0, 2]]), 0.99, 100)
+
+
+def test_oracle_travels_less_than_nearest_path_on_validation_episodes() -> None:
+    from frontier_marl.evaluation.benchmark import contenders, run_family
+    from frontier_marl.evaluation.families import family, variant_configs
+    from frontier_marl.evaluation.records import level_key
+
+    fam = family("random-20")
+    worlds = variant_configs(fam)
+    t99 = {}
+    for contender in contenders(["nearest-path", "lookahead-oracle"]):
+        result = run_family(fam, contender, worlds, 4, split="validation")
+        t99[contender.name] = [e.cells_to_coverage[level_key(0.99)] for e in result.episodes]
+    assert None not in t99["lookahead-oracle"]
+    assert np.mean(t99["lookahead-oracle"]) < 0.95 * np.mean(t99["nearest-path"])
+
+
+def test_oracle_is_never_the_best_heuristic_and_refuses_teams(tmp_path) -> None:
+    from frontier_marl.cli import main
+    from frontier_marl.evaluation.benchmark import contenders, run_benchmark
+    from frontier_marl.evaluation.families import family
+
+    rows = run_benchmark(
+        [family("random-20")], contenders(["nearest-path", "lookahead-oracle"]), episodes=2
+    )
+    assert [row["best_heuristic"] for row in rows] == ["nearest-path"] * 2
+    assert main(["benchmark", "--policies", "lookahead-oracle", "--agents", "2"]) == 2
+    import frontier_marl
+
+    env = frontier_marl.parallel_env(preset="thesis-20x20", n_agents=2)
+    with pytest.raises(ValueError, match="one robot"):
+        LookaheadOracle().attach(env)
+
+
+def test_imitation_labels_real_decisions_and_fits_them() -> None:
+    from frontier_marl.config import make_config
+    from frontier_marl.envs.parallel import FrontierParallelEnv
+    from frontier_marl.evaluation.families import family, variant_configs
+    from frontier_marl.training.imitation import Dataset, fit, play
+    from frontier_marl.training.slot_policy import SlotScorer
+
+    own = {"features": "explorer", "n_slots": 6, "gain": "unknown", "commit": "until-reached"}
+    world = variant_configs(family("random-20"))[0]
+    cfg = make_config(config=world, **own)
+    data = Dataset()
+    env = FrontierParallelEnv(config=cfg)
+    travelled = play(env, 5, data, None, 1.0, np.random.default_rng(0))
+    assert len(data) > 0 and travelled > 0
+    slots, masks, targets, valid = data.tensors()
+    assert slots.shape == (len(data), 6, 10) and masks.shape == (len(data), 6)
+    assert (valid.sum(dim=1) >= 2).all()  # only decisions with a choice are labelled
+    assert torch.equal(valid, masks.bool())
+    assert (targets <= 0).all() and (targets.max(dim=1).values == 0).all()  # 0: the cheapest
+
+    class Net(torch.nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.scorer = SlotScorer(6, 10, [16, 16], torch.nn.ReLU)
+
+        def forward(self, obs: dict[str, torch.Tensor]) -> torch.Tensor:
+            flat = torch.cat([obs["slots"].flatten(1), obs["action_mask"].float()], dim=1)
+            return self.scorer(flat)
+
+    losses = fit(Net(), data, 20, 32, 1e-2, torch.Generator().manual_seed(0))
+    assert len(losses) == 20 and losses[-1] < losses[0]
