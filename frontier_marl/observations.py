@@ -202,7 +202,7 @@ def teammate_rows(table: np.ndarray) -> np.ndarray:
 
 def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
     """A JSON-able description of the observation layout, used to check saved models (the
-    explorer layout's does not name the map size: it fits every size)."""
+    explorer layout's names neither the map size nor the team size: it fits every one)."""
     enc = ObservationEncoder(cfg)
     if enc.features == "explorer":
         return {
@@ -210,7 +210,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "gain": cfg.gain,
             "sort_by_distance": cfg.observation.sort_by_distance,
             "teammates": cfg.observation.teammates,
-            "n_agents": cfg.n_agents if cfg.observation.teammates != "none" else None,
+            "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,
         }

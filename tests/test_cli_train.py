@@ -232,3 +232,47 @@ def test_train_the_explorer_on_families_and_benchmark_it(tmp_path: Path, capsys)
         "random-20", "random-30", "rooms-32", "rooms-64"
     }  # fmt: skip
     assert all(row["seeds"][0] == 800_000 for row in rows)
+
+
+def test_train_a_team_model_on_families_and_team_sizes(tmp_path: Path) -> None:
+    """The team-explorer config trains (tiny budget) one parameter-shared model on every
+    family and team size, validates it by makespan against utility-discount, and the benchmark
+    runs it with a team size it was not validated on."""
+    run_dir = tmp_path / "team"
+    overrides = ["--set", "dqn.learning_starts=50", "--set", "train.n_envs=1", "--no-progress"]
+    overrides += ["--set", "train.validate_every=300", "--set", "train.validation_episodes=1"]
+    overrides += ["--set", "train.agents=[2, 3]"]
+    assert (
+        main(["train", "team-explorer", "--steps", "300", "--out", str(run_dir), *overrides]) == 0
+    )
+    meta = json.loads((run_dir / "model.json").read_text())
+    assert meta["observation_layout"]["n_agents"] is None  # the layout fits every team size
+    assert meta["experiment"]["train"]["agents"] == [2, 3]
+    (record,) = [json.loads(line) for line in (run_dir / "validation.jsonl").read_text().splitlines()]
+    assert record["reference"] == "utility-discount" and record["metric"] == "makespan99"
+    assert set(record["by_family"]) == {"random-30", "rooms-64"}
+    out = tmp_path / "bench.json"
+    argv = ["benchmark", "--families", "random-30", "--agents", "4", "--policies"]
+    argv += [f"utility-discount,{run_dir}", "--episodes", "1", "--split", "validation"]
+    assert main([*argv, "--json", str(out), "--no-progress"]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["agents"] for row in rows] == [4, 4]
+    assert rows[1]["best_heuristic_makespan"] == "utility-discount"
+
+
+@pytest.mark.parametrize(
+    "agents, message",
+    [([0], "team sizes >= 1"), ([], "team sizes >= 1"), ([True], "team sizes >= 1")],
+)
+def test_bad_team_sizes_are_refused(agents: list, message: str) -> None:
+    from frontier_marl.training.experiment import load_experiment
+
+    with pytest.raises(ValueError, match=message):
+        load_experiment("team-explorer", [f"train.agents={agents}".replace("True", "true")])
+
+
+def test_team_sizes_need_families() -> None:
+    from frontier_marl.training.experiment import load_experiment
+
+    with pytest.raises(ValueError, match="needs train.families"):
+        load_experiment("config01", ["train.agents=[2]"])

@@ -137,6 +137,9 @@ def run(args: argparse.Namespace) -> int:
     if settings.families:
         world = f"families {', '.join(settings.families)}, {cfg.map_mode} maps"
         worlds = f"{settings.n_envs} worlds per family"
+        if settings.agents != (1,):
+            sizes = ", ".join(map(str, settings.agents))
+            worlds += f" and team size ({sizes} robots; validated with {settings.agents[0]})"
     else:
         world = f"{cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map"
         worlds = f"{settings.n_envs} world(s)"

@@ -36,6 +36,9 @@ from typing import Any
 from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.thesis import DQN_HYPERPARAMETERS
+from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
+
+__all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
 
 #: The thesis's final DQN hyperparameters; everything else is SB3's default.
 THESIS_DQN = DQN_HYPERPARAMETERS
@@ -51,128 +54,6 @@ _RESERVED_DQN = {
     "verbose",
     "_init_setup_model",
 }
-
-
-EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
-VEC_ENVS = ("batched", "supersuit")
-POLICIES = ("auto", "slot-scorer")
-
-
-@dataclass(frozen=True)
-class TrainSettings:
-    """Budget and bookkeeping of one training run.
-
-    Attributes:
-        total_timesteps: environment steps (transitions) to train for.
-        seed: seeds torch/numpy/random, the action space, and every vector copy (distinctly).
-        n_envs: worlds stepped side by side (1 keeps ``train_freq`` in the thesis's units).
-        vec_env: how they are stepped: ``batched`` (the default; all worlds in one call,
-            :mod:`frontier_marl.envs.vector`) or ``supersuit`` (SuperSuit's concatenated
-            copies of the ParallelEnv). Both give the same transitions.
-        checkpoint_every: steps between checkpoints (model + replay buffer + metadata);
-            0 disables periodic checkpoints (the final model and Ctrl-C still save).
-        keep_checkpoints: newest checkpoints kept on disk (0 keeps all).
-        log_interval: episodes between logger dumps (TensorBoard and metrics.jsonl).
-        eval_episodes: episodes of the final deterministic evaluation (0 skips it).
-        eval_seed: first seed of the evaluation episodes.
-        eval_map_mode: map mode of the final evaluation: ``as-trained`` (the default),
-            ``static`` (the thesis protocol, e.g. after training on dynamic maps) or ``dynamic``.
-            Validation always uses the training env.
-        torch_threads: ``torch.set_num_threads`` value (1 is fastest for this small MLP).
-        device: torch device of the model.
-        bootstrap_truncations: pass truncations to SB3 as truncations (``TimeLimit.truncated``,
-            the TD target bootstraps there). False treats them as terminal, as SuperSuit does
-            by itself (an experiment option; see docs/results.md).
-        validate_every: steps between validations of the greedy policy on held-out episodes
-            (0: none). The best-scoring policy is kept in ``RUN/best/`` and evaluated with
-            the thesis protocol at the end, beside the final one (SB3's ``EvalCallback``
-            practice).
-        validation_episodes: episodes per validation.
-        validation_seed: first reset seed of the validation episodes; the range must not
-            overlap the evaluation's (``eval_seed`` .. ``eval_seed + eval_episodes - 1``).
-        policy: ``auto`` (SB3's ``MlpPolicy`` or ``MultiInputPolicy``, by observation) or
-            ``slot-scorer`` (the masked, permutation-equivariant Q-network of
-            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; needs
-            ``features = "explorer"``).
-        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.families`),
-            ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
-            range; ``[env]`` then sets the observation and reward (not the map). Empty: the
-            ``[env]`` world.
-    """
-
-    total_timesteps: int = 1_000_000
-    seed: int = 0
-    n_envs: int = 1
-    vec_env: str = "batched"
-    checkpoint_every: int = 100_000
-    keep_checkpoints: int = 2
-    log_interval: int = 10
-    eval_episodes: int = 30
-    eval_seed: int = 0
-    eval_map_mode: str = "as-trained"
-    torch_threads: int = 1
-    device: str = "cpu"
-    bootstrap_truncations: bool = True
-    validate_every: int = 0
-    validation_episodes: int = 30
-    validation_seed: int = 1000
-    policy: str = "auto"
-    families: tuple[str, ...] = ()
-
-    def __post_init__(self) -> None:
-        for name, low in (
-            ("total_timesteps", 1),
-            ("seed", 0),
-            ("n_envs", 1),
-            ("checkpoint_every", 0),
-            ("keep_checkpoints", 0),
-            ("log_interval", 1),
-            ("eval_episodes", 0),
-            ("eval_seed", 0),
-            ("torch_threads", 1),
-            ("validate_every", 0),
-            ("validation_episodes", 1),
-            ("validation_seed", 0),
-        ):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
-        if self.policy not in POLICIES:
-            raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
-        if self.families:
-            from frontier_marl.evaluation.families import check_families
-
-            check_families(self.families, "train.families")
-            if self.vec_env != "batched":
-                raise ValueError("train.families needs train.vec_env = 'batched'")
-        if self.vec_env not in VEC_ENVS:
-            raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
-        if not isinstance(self.bootstrap_truncations, bool):
-            raise ValueError(
-                "train.bootstrap_truncations must be true or false, "
-                f"got {self.bootstrap_truncations!r}"
-            )
-        if self.validate_every and self.eval_episodes:
-            first = self.validation_seed
-            validation = range(first, first + self.validation_episodes)
-            evaluation = range(self.eval_seed, self.eval_seed + self.eval_episodes)
-            if validation.start < evaluation.stop and evaluation.start < validation.stop:
-                raise ValueError(
-                    f"train.validation_seed: validation episodes (seeds {validation.start}.."
-                    f"{validation.stop - 1}) overlap the evaluation episodes (seeds "
-                    f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
-                    "on the evaluation episodes would bias the evaluation"
-                )
-        if self.eval_map_mode not in EVAL_MAP_MODES:
-            raise ValueError(
-                f"train.eval_map_mode must be one of {', '.join(EVAL_MAP_MODES)}, "
-                f"got {self.eval_map_mode!r}"
-            )
-        if not isinstance(self.device, str) or not self.device:
-            raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
-
-
-_TRAIN_KEYS = {f.name for f in dataclasses.fields(TrainSettings)}
 
 
 @dataclass(frozen=True)
@@ -192,12 +73,16 @@ class Experiment:
         return self.env_configs()[0]
 
     def env_configs(self) -> list[EnvConfig]:
-        """One env config per training family (``[env]`` on each family's world), or the
-        ``[env]`` config alone."""
+        """One env config per training family and team size (``[env]`` on each family's world
+        with ``train.agents`` robots, families first), or the ``[env]`` config alone."""
         if self.train.families:
             from frontier_marl.evaluation.families import family, variant_configs
 
-            return [variant_configs(family(name), self.env)[0] for name in self.train.families]
+            return [
+                variant_configs(family(name), self.env, agents)[0]
+                for name in self.train.families
+                for agents in self.train.agents
+            ]
         kwargs = dict(self.env)
         preset = kwargs.pop("preset", "thesis-20x20")
         return [make_config(preset, **kwargs)]
@@ -209,7 +94,11 @@ class Experiment:
             "description": self.description,
             "env": dict(self.env),
             "dqn": dict(self.dqn),
-            "train": {**dataclasses.asdict(self.train), "families": list(self.train.families)},
+            "train": {
+                **dataclasses.asdict(self.train),
+                "families": list(self.train.families),
+                "agents": list(self.train.agents),
+            },
         }
 
 
@@ -241,12 +130,13 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         env["map_path"] = str(example_map_path(map_name))  # a shipped example map by name
     dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
     train_kw = dict(data.get("train", {}))
-    if isinstance(train_kw.get("families"), list):
-        train_kw["families"] = tuple(train_kw["families"])
-    bad_train = set(train_kw) - _TRAIN_KEYS
+    for key in ("families", "agents"):
+        if isinstance(train_kw.get(key), list):
+            train_kw[key] = tuple(train_kw[key])
+    bad_train = set(train_kw) - TRAIN_KEYS
     if bad_train:
         raise ValueError(
-            f"unknown [train] key(s) {sorted(bad_train)}{where}; allowed: {sorted(_TRAIN_KEYS)}"
+            f"unknown [train] key(s) {sorted(bad_train)}{where}; allowed: {sorted(TRAIN_KEYS)}"
         )
     bad_dqn = set(dqn) - dqn_keys()
     if bad_dqn:
@@ -331,7 +221,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
     owners = [
         section
         for section, keys in (
-            ("train", _TRAIN_KEYS),
+            ("train", TRAIN_KEYS),
             ("dqn", dqn_keys()),
             ("env", set(config_keys())),
         )

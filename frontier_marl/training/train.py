@@ -134,7 +134,8 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
     from frontier_marl.evaluation.families import family
 
     parts = []
-    for i, (name, cfg) in enumerate(zip(settings.families, experiment.env_configs(), strict=True)):
+    names = [name for name in settings.families for _ in settings.agents]
+    for i, (name, cfg) in enumerate(zip(names, experiment.env_configs(), strict=True)):
         seeds = family(name).train
         part = make_batched_vec_env(
             {"config": cfg}, settings.n_envs, seed + 1000 * i, bootstrap, seed_range=seeds
@@ -245,7 +246,9 @@ def train(
         if settings.families:
             from frontier_marl.training.family_validation import FamilyValidator
 
-            scorer = FamilyValidator(settings.families, settings.validation_episodes, cfg)
+            scorer = FamilyValidator(
+                settings.families, settings.validation_episodes, cfg, settings.agents[0]
+            )
             log_key = "eval/validation_score"
         keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, start_step, scorer)
         all_callbacks.append(Periodic(settings.validate_every, keeper, log_key=log_key))

@@ -1,0 +1,137 @@
+"""The ``[train]`` section of an experiment config: budget, seed, vector env, validation."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
+VEC_ENVS = ("batched", "supersuit")
+POLICIES = ("auto", "slot-scorer")
+
+
+@dataclass(frozen=True)
+class TrainSettings:
+    """Budget and bookkeeping of one training run.
+
+    Attributes:
+        total_timesteps: environment steps (transitions) to train for.
+        seed: seeds torch/numpy/random, the action space, and every vector copy (distinctly).
+        n_envs: worlds stepped side by side (1 keeps ``train_freq`` in the thesis's units).
+        vec_env: how they are stepped: ``batched`` (the default; all worlds in one call,
+            :mod:`frontier_marl.envs.vector`) or ``supersuit`` (SuperSuit's concatenated
+            copies of the ParallelEnv). Both give the same transitions.
+        checkpoint_every: steps between checkpoints (model + replay buffer + metadata);
+            0 disables periodic checkpoints (the final model and Ctrl-C still save).
+        keep_checkpoints: newest checkpoints kept on disk (0 keeps all).
+        log_interval: episodes between logger dumps (TensorBoard and metrics.jsonl).
+        eval_episodes: episodes of the final deterministic evaluation (0 skips it).
+        eval_seed: first seed of the evaluation episodes.
+        eval_map_mode: map mode of the final evaluation: ``as-trained`` (the default),
+            ``static`` (the thesis protocol, e.g. after training on dynamic maps) or ``dynamic``.
+            Validation always uses the training env.
+        torch_threads: ``torch.set_num_threads`` value (1 is fastest for this small MLP).
+        device: torch device of the model.
+        bootstrap_truncations: pass truncations to SB3 as truncations (``TimeLimit.truncated``,
+            the TD target bootstraps there). False treats them as terminal, as SuperSuit does
+            by itself (an experiment option; see docs/results.md).
+        validate_every: steps between validations of the greedy policy on held-out episodes
+            (0: none). The best-scoring policy is kept in ``RUN/best/`` and evaluated with
+            the thesis protocol at the end, beside the final one (SB3's ``EvalCallback``
+            practice).
+        validation_episodes: episodes per validation.
+        validation_seed: first reset seed of the validation episodes; the range must not
+            overlap the evaluation's (``eval_seed`` .. ``eval_seed + eval_episodes - 1``).
+        policy: ``auto`` (SB3's ``MlpPolicy`` or ``MultiInputPolicy``, by observation) or
+            ``slot-scorer`` (the masked, permutation-equivariant Q-network of
+            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; needs
+            ``features = "explorer"``).
+        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.families`),
+            ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
+            range; ``[env]`` then sets the observation and reward (not the map). Empty: the
+            ``[env]`` world.
+        agents: team sizes to train on with ``families``: ``n_envs`` worlds of every family
+            with every team size (one parameter-shared model acts for each robot). The first
+            size is the one validated.
+    """
+
+    total_timesteps: int = 1_000_000
+    seed: int = 0
+    n_envs: int = 1
+    vec_env: str = "batched"
+    checkpoint_every: int = 100_000
+    keep_checkpoints: int = 2
+    log_interval: int = 10
+    eval_episodes: int = 30
+    eval_seed: int = 0
+    eval_map_mode: str = "as-trained"
+    torch_threads: int = 1
+    device: str = "cpu"
+    bootstrap_truncations: bool = True
+    validate_every: int = 0
+    validation_episodes: int = 30
+    validation_seed: int = 1000
+    policy: str = "auto"
+    families: tuple[str, ...] = ()
+    agents: tuple[int, ...] = (1,)
+
+    def __post_init__(self) -> None:
+        for name, low in (
+            ("total_timesteps", 1),
+            ("seed", 0),
+            ("n_envs", 1),
+            ("checkpoint_every", 0),
+            ("keep_checkpoints", 0),
+            ("log_interval", 1),
+            ("eval_episodes", 0),
+            ("eval_seed", 0),
+            ("torch_threads", 1),
+            ("validate_every", 0),
+            ("validation_episodes", 1),
+            ("validation_seed", 0),
+        ):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if self.policy not in POLICIES:
+            raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
+        if self.families:
+            from frontier_marl.evaluation.families import check_families
+
+            check_families(self.families, "train.families")
+            if self.vec_env != "batched":
+                raise ValueError("train.families needs train.vec_env = 'batched'")
+        if not self.agents or any(
+            isinstance(k, bool) or not isinstance(k, int) or k < 1 for k in self.agents
+        ):
+            raise ValueError(f"train.agents must be team sizes >= 1, got {list(self.agents)!r}")
+        if self.agents != (1,) and not self.families:
+            raise ValueError("train.agents needs train.families (the team sizes of their worlds)")
+        if self.vec_env not in VEC_ENVS:
+            raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
+        if not isinstance(self.bootstrap_truncations, bool):
+            raise ValueError(
+                "train.bootstrap_truncations must be true or false, "
+                f"got {self.bootstrap_truncations!r}"
+            )
+        if self.validate_every and self.eval_episodes:
+            first = self.validation_seed
+            validation = range(first, first + self.validation_episodes)
+            evaluation = range(self.eval_seed, self.eval_seed + self.eval_episodes)
+            if validation.start < evaluation.stop and evaluation.start < validation.stop:
+                raise ValueError(
+                    f"train.validation_seed: validation episodes (seeds {validation.start}.."
+                    f"{validation.stop - 1}) overlap the evaluation episodes (seeds "
+                    f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
+                    "on the evaluation episodes would bias the evaluation"
+                )
+        if self.eval_map_mode not in EVAL_MAP_MODES:
+            raise ValueError(
+                f"train.eval_map_mode must be one of {', '.join(EVAL_MAP_MODES)}, "
+                f"got {self.eval_map_mode!r}"
+            )
+        if not isinstance(self.device, str) or not self.device:
+            raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
+
+
+TRAIN_KEYS = {f.name for f in dataclasses.fields(TrainSettings)}
