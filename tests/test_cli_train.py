@@ -248,7 +248,9 @@ def test_train_a_team_model_on_families_and_team_sizes(tmp_path: Path) -> None:
     meta = json.loads((run_dir / "model.json").read_text())
     assert meta["observation_layout"]["n_agents"] is None  # the layout fits every team size
     assert meta["experiment"]["train"]["agents"] == [2, 3]
-    (record,) = [json.loads(line) for line in (run_dir / "validation.jsonl").read_text().splitlines()]
+    (record,) = [
+        json.loads(line) for line in (run_dir / "validation.jsonl").read_text().splitlines()
+    ]
     assert record["reference"] == "utility-discount" and record["metric"] == "makespan99"
     assert set(record["by_family"]) == {"random-30", "rooms-64"}
     out = tmp_path / "bench.json"
