@@ -114,6 +114,10 @@ def test_a_failing_run_stops_the_others_and_raises_its_error(tmp_path: Path) -> 
     broken = TrainJob(tiny(1), blocker / "seed1", label="seed 1")  # its folder cannot exist
     with pytest.raises(OSError):
         train_runs([healthy, broken], workers=2, progress=False)
+    if not healthy.run_dir.exists():
+        # On a loaded machine the broken run can fail before the healthy one starts: the
+        # healthy one then never starts (no folder); otherwise it saves a checkpoint.
+        return
     [checkpoint] = list_checkpoints(healthy.run_dir)  # stopped early, with a checkpoint
     assert 0 < checkpoint.step < 100_000
     assert (healthy.run_dir / "model.zip").is_file()
