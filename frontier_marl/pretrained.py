@@ -4,7 +4,8 @@
 
 Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with its
 ``model.json`` metadata (env config, observation layout, training run). How each was trained is
-in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``).
+in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``,
+``team-explorer``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,10 @@ PRETRAINED: dict[str, str] = {
     "permutation-equivariant slot scorer on size-independent slot features, trained on the "
     "four benchmark map families by `frontier-marl train explorer` (seed 0); the "
     "best-validated policy (step 200,000)",
+    "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
+    "slot scorer with three teammate features per slot, one parameter-shared model for teams "
+    "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
+    "(seed 0); the best-validated policy (step 1,400,000)",
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
     "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
     "frontier-marl reproduce run, the seed whose protocol score is the median of the three",

@@ -228,3 +228,19 @@ def test_the_shipped_explorer_acts_on_every_family_and_a_floor_plan_size(tmp_pat
         "random-20", "random-30", "rooms-32", "rooms-64", "map:rooms-128"
     }  # fmt: skip
     assert all(row["success"] == 1 for row in rows)
+
+
+def test_the_shipped_team_explorer_acts_for_teams_of_2_4_and_8(tmp_path) -> None:
+    """`team-explorer` by name: one model, every robot acting from its own observation."""
+    import json
+
+    from frontier_marl.cli import main
+
+    for agents in (2, 4, 8):
+        out = tmp_path / f"bench-{agents}.json"
+        argv = ["benchmark", "--policies", "team-explorer", "--episodes", "1", "--split"]
+        argv += ["validation", "--families", "random-30,rooms-64", "--agents", str(agents)]
+        assert main([*argv, "--json", str(out), "--no-progress"]) == 0
+        rows = json.loads(out.read_text())["rows"]
+        assert [row["agents"] for row in rows] == [agents, agents]
+        assert all(row["success"] == 1 for row in rows)
