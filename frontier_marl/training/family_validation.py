@@ -44,7 +44,8 @@ def _t99(result: Any) -> list[float | None]:
 
 class FamilyValidator:
     """``validator(model)`` -> a validation record whose ``score`` is minus the mean relative
-    T99 difference to nearest-path (see the module docstring)."""
+    difference to the reference heuristic: T99 against nearest-path for one robot, the
+    makespan against utility-discount for ``agents`` robots (see the module docstring)."""
 
     def __init__(
         self, families: Sequence[str], episodes: int, model_config: EnvConfig, agents: int = 1
