@@ -22,7 +22,7 @@ PRETRAINED: dict[str, str] = {
     "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
     "slot scorer with three teammate features per slot, one parameter-shared model for teams "
     "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
-    "(seed 0); the best-validated policy (step 1,400,000)",
+    "(seed 0); the best-validated policy (step 1,600,032)",
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
     "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
     "frontier-marl reproduce run, the seed whose protocol score is the median of the three",
