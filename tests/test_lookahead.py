@@ -62,7 +62,7 @@ def test_oracle_travels_less_than_nearest_path_on_validation_episodes() -> None:
     assert np.mean(t99["lookahead-oracle"]) < 0.95 * np.mean(t99["nearest-path"])
 
 
-def test_oracle_is_never_the_best_heuristic_and_refuses_teams(tmp_path) -> None:
+def test_oracle_is_never_the_best_heuristic_and_refuses_teams() -> None:
     from frontier_marl.cli import main
     from frontier_marl.evaluation.benchmark import contenders, run_benchmark
     from frontier_marl.evaluation.families import family

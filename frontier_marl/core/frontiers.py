@@ -134,6 +134,18 @@ def unknown_around(belief: np.ndarray, clusters: Clusters) -> np.ndarray:
 
 
 @compiled
+def is_frontier(belief: np.ndarray, r: int, c: int) -> bool:
+    """Cell (r, c) is free with an unknown 4-neighbour."""
+    height, width = belief.shape
+    return belief[r, c] == FREE and (
+        (r > 0 and belief[r - 1, c] == UNKNOWN)
+        or (r + 1 < height and belief[r + 1, c] == UNKNOWN)
+        or (c > 0 and belief[r, c - 1] == UNKNOWN)
+        or (c + 1 < width and belief[r, c + 1] == UNKNOWN)
+    )
+
+
+@compiled
 def frontier_cells(belief: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(mask, rows, cols) of the frontier cells, cells in raster order."""
     height, width = belief.shape
@@ -143,14 +155,7 @@ def frontier_cells(belief: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     n = 0
     for r in range(height):
         for c in range(width):
-            if belief[r, c] != FREE:
-                continue
-            if (
-                (r > 0 and belief[r - 1, c] == UNKNOWN)
-                or (r + 1 < height and belief[r + 1, c] == UNKNOWN)
-                or (c > 0 and belief[r, c - 1] == UNKNOWN)
-                or (c + 1 < width and belief[r, c + 1] == UNKNOWN)
-            ):
+            if is_frontier(belief, r, c):
                 mask[r, c] = True
                 rows[n] = r
                 cols[n] = c

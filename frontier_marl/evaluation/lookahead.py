@@ -23,13 +23,15 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.grid import FREE, UNKNOWN
+from frontier_marl.core.frontiers import is_frontier
 from frontier_marl.core.slots import SlotArrays
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.evaluation.policies import HeuristicPolicy, Info, first_by, slot_table
 
-_COPIED = ("true", "belief", "positions", "seen", "travelled", "start_region")
-_COPIED_SCALARS = ("start_region_size", "true_free")
+_COPIED = (
+    "true", "belief", "positions", "seen", "travelled", "start_region", "start_region_size",
+    "true_free",
+)  # fmt: skip
 ROLLOUT_SLOTS = 256  # the base policy sees every reachable cluster, as the heuristics do
 
 
@@ -38,8 +40,6 @@ def copy_world(source: Worlds, index: int, target: Worlds, rows: np.ndarray) -> 
     parameters); their plans and targets are cleared."""
     for name in _COPIED:
         getattr(target, name)[rows] = getattr(source, name)[index]
-    for name in _COPIED_SCALARS:
-        getattr(target, name)[rows] = getattr(source, name)[index]
     target.plan_meta[rows] = -1
     target.goals[rows] = -1
     target.version[rows] += 1
@@ -47,31 +47,22 @@ def copy_world(source: Worlds, index: int, target: Worlds, rows: np.ndarray) -> 
 
 @compiled
 def _still_frontier(belief: np.ndarray, goals: np.ndarray, worlds: np.ndarray) -> np.ndarray:
-    """Per listed world: robot 0's goal is a free cell with an unknown 4-neighbour."""
-    height, width = belief.shape[1], belief.shape[2]
+    """Per listed world: robot 0's goal is still a frontier cell."""
     out = np.zeros(len(worlds), dtype=np.bool_)
     for m in range(len(worlds)):
         n = worlds[m]
         r, c = goals[n, 0, 0], goals[n, 0, 1]
-        if r < 0 or belief[n, r, c] != FREE:
-            continue
-        out[m] = (
-            (r > 0 and belief[n, r - 1, c] == UNKNOWN)
-            or (r + 1 < height and belief[n, r + 1, c] == UNKNOWN)
-            or (c > 0 and belief[n, r, c - 1] == UNKNOWN)
-            or (c + 1 < width and belief[n, r, c + 1] == UNKNOWN)
-        )
+        out[m] = r >= 0 and is_frontier(belief[n], r, c)
     return out
 
 
 def _nearest_path(slots: SlotArrays, world: int) -> np.ndarray | None:
     """Robot 0's nearest live slot target by path length (ties: centroid distance)."""
-    valid = slots.valid[world, 0]
-    if not valid.any():
+    live = np.flatnonzero(slots.valid[world, 0])
+    if not len(live):
         return None
-    live = np.flatnonzero(valid)
-    order = np.lexsort((slots.distance[world, 0, live], slots.path_length[world, 0, live]))
-    return slots.target[world, 0, live[order[0]]]
+    best = first_by(slots.path_length[world, 0, live], slots.distance[world, 0, live])
+    return slots.target[world, 0, live[best]]
 
 
 def lookahead_costs(
@@ -115,10 +106,7 @@ def lookahead_costs(
                     done[world] = True
                 else:
                     sims.goals[world, 0] = goal
-        moving = np.zeros(count, dtype=bool)
-        moving[~done] = True
-        sims.reached[:] = False
-        sims.move(sims.goals, moving)
+        sims.move(sims.goals, ~done)  # resets ``reached`` of every world it moves
 
 
 class LookaheadOracle(HeuristicPolicy):
