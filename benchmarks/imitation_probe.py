@@ -4,7 +4,7 @@
     python benchmarks/imitation_probe.py --json probe.json --rounds 6
 
 DAgger with :mod:`frontier_marl.training.imitation` on the explorer config's observation and
-network (``frontier_marl/assets/configs/explorer.toml``), training seeds only. Round 0 follows
+network (``frontier_marl/assets/configs/explorer-dqn.toml``), training seeds only. Round 0 follows
 the oracle; round ``r`` follows it with probability ``0.5 ** r`` and the student otherwise.
 Every decision is labelled with the oracle's cost of each valid slot. After each round, the
 student is fitted on all rounds so far and scored two ways:
@@ -72,7 +72,7 @@ def main() -> None:
     args = parser.parse_args()
     th.set_num_threads(1)
     th.manual_seed(args.seed)
-    experiment = load_experiment("explorer")
+    experiment = load_experiment("explorer-dqn")
     configs = experiment.env_configs()
     names = experiment.train.families
     vec_env = make_batched_vec_env({"config": configs[0]}, 1, args.seed)

@@ -79,8 +79,9 @@ class BatchMDP:
     # ------------------------------------------------------------------ transition
     def step(self, actions: np.ndarray, active: np.ndarray) -> None:
         """One decision per robot of the ``active`` worlds (bool (N,)): ``actions`` (N, K)
-        holds valid slot indices (checked by the caller). Inactive worlds (ended, about to be
-        reset) do not move and get no reward or end flag."""
+        holds valid slot indices (checked by the caller). Inactive worlds (ended, or waiting
+        while others play forced steps) keep their state: they do not move and get no reward
+        or end flag."""
         slots = self.slots
         live = slots.live
         chosen = actions < live  # live slots come first
@@ -88,14 +89,14 @@ class BatchMDP:
         targets = np.where(chosen[..., None], picked, -1)
         targets[~active] = -1
         padding = ~chosen & (live > 0) & active[:, None]
-        oscillation = self._oscillation.update(targets)
+        oscillation = self._oscillation.update(targets, active)
         worlds = self.worlds
         before = worlds.travelled.copy()
         worlds.move(targets, active)
         new_cells = np.where(active[:, None], worlds.new_cells, 0)
         self.steps += active
         progress = new_cells.any(axis=1)
-        self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + 1)
+        self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + active)
         indices = self._all[active]
         worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
         if self.cfg.observation.commit != "none":
@@ -127,9 +128,37 @@ class BatchMDP:
         outcome.reason[~active] = 0
         self.done |= outcome.terminated | outcome.truncated
         going = (targets[..., 0] >= 0) & ~worlds.reached
-        self.heading = np.where(going[..., None], targets, -1)
-        self.targets, self.padding, self.oscillation = targets, padding, oscillation
+        # inactive worlds keep their targets, heading and flags
+        moved = active[:, None]
+        heading = np.where(going[..., None], targets, -1)
+        self.heading = np.where(moved[..., None], heading, self.heading)
+        self.targets = np.where(moved[..., None], targets, self.targets)
+        self.padding = np.where(moved, padding, self.padding)
+        self.oscillation = np.where(moved, oscillation, self.oscillation)
         self.new_cells, self.outcome = new_cells, outcome
+
+    def play_forced(self) -> int:
+        """Step every live world whose robots each have exactly one valid slot (a commitment,
+        or a single cluster) with that slot, until every live world offers a choice or has
+        ended. ``outcome`` then holds the rewards summed since the last decision and the ends
+        reached on the way. Returns the steps played (the most any world took)."""
+        total = self.outcome
+        rewards, reason = total.rewards.copy(), total.reason.copy()
+        terminated, truncated = total.terminated.copy(), total.truncated.copy()
+        played = 0
+        while True:
+            forced = ~self.done & (self.slots.mask.sum(axis=2) == 1).all(axis=1)
+            if not forced.any():
+                break
+            self.step(self.slots.mask.argmax(axis=2), forced)
+            step = self.outcome
+            rewards += step.rewards
+            terminated |= step.terminated
+            truncated |= step.truncated
+            reason = np.where(step.reason != 0, step.reason, reason)
+            played += 1
+        self.outcome = BatchOutcome(rewards, terminated, truncated, reason)
+        return played
 
     # ------------------------------------------------------------------ views
     def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:

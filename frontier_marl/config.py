@@ -59,6 +59,9 @@ class ObservationConfig:
             features (:mod:`frontier_marl.slot_features`); the axes above are then unused.
         commit: narrow the action mask to the previous target's slot: ``until-progress``, or
             ``until-reached``; ``none`` keeps every live slot (docs/environment.md).
+        tour: with ``features="explorer"``, one more feature per slot: the length of the
+            nearest-neighbour tour from the slot's target through every other live slot's
+            target (:func:`frontier_marl.slot_features.tour_lengths`).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -70,14 +73,24 @@ class ObservationConfig:
     teammates: TeammateEncoding = "none"
     features: FeatureLayout = "thesis"
     commit: CommitRule = "none"
+    tour: bool = False
 
     def validate(self) -> None:
         check_choice("features", self.features, get_args(FeatureLayout))
         check_choice("commit", self.commit, get_args(CommitRule))
         check_choice("centroid", self.centroid, get_args(CentroidEncoding))
         check_choice("teammates", self.teammates, get_args(TeammateEncoding))
-        for name in ("agent_position", "info_gain", "sort_by_distance", "action_mask", "normalize"):
+        for name in (
+            "agent_position",
+            "info_gain",
+            "sort_by_distance",
+            "action_mask",
+            "normalize",
+            "tour",
+        ):
             check_bool(name, getattr(self, name))
+        if self.tour and self.features != "explorer":
+            raise ValueError("tour=True needs features='explorer' (it is a per-slot feature)")
         if self.centroid == "none" and not self.info_gain:
             raise ValueError(
                 "observation is empty: centroid='none' needs info_gain=True "

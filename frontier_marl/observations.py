@@ -33,6 +33,7 @@ from frontier_marl.slot_features import (
     explorer_features,
     explorer_space,
     team_features,
+    tour_lengths,
 )
 
 
@@ -53,7 +54,8 @@ class ObservationEncoder:
         self.features = obs.features
         if self.features == "explorer":
             team = len(TEAM_FEATURES) if self.teammates != "none" else 0
-            self.features_per_slot = len(EXPLORER_FEATURES) + team
+            self.tour = obs.tour
+            self.features_per_slot = len(EXPLORER_FEATURES) + int(self.tour) + team
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
         height, width = cfg.height, cfg.width
@@ -140,6 +142,8 @@ class ObservationEncoder:
             if heading is None:
                 heading = np.full_like(positions, -1)
             features = explorer_features(slots, positions, heading)
+            if self.tour:
+                features = np.concatenate([features, tour_lengths(slots)], axis=-1)
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
@@ -210,6 +214,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "gain": cfg.gain,
             "sort_by_distance": cfg.observation.sort_by_distance,
             "teammates": cfg.observation.teammates,
+            "tour": cfg.observation.tour,
             "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,

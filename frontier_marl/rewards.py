@@ -52,10 +52,17 @@ class OscillationHistory:
         """Forget the history of ``worlds`` (a new episode)."""
         self._history[worlds] = self._EMPTY
 
-    def update(self, targets: np.ndarray) -> np.ndarray:
-        """Record ``targets`` (W, N, 2); returns bool (W, N): which robots oscillate."""
-        out = np.empty(targets.shape[:2], dtype=np.bool_)
-        _oscillation_update(self._history, np.asarray(targets, dtype=np.int64), out)
+    def update(self, targets: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+        """Record ``targets`` (W, N, 2) of the ``active`` worlds (bool (W,), None: all);
+        returns bool (W, N): which robots oscillate (False in inactive worlds)."""
+        targets = np.asarray(targets, dtype=np.int64)
+        out = np.zeros(targets.shape[:2], dtype=np.bool_)
+        if active is None or active.all():
+            _oscillation_update(self._history, targets, out)
+            return out
+        history, moved = self._history[active], out[active]
+        _oscillation_update(history, targets[active], moved)
+        self._history[active], out[active] = history, moved
         return out
 
 

@@ -15,6 +15,12 @@ same features on a 20x20 grid and on a 64x64 floor plan. Per slot, in order
 ``current``     1 if the slot's target is the cell the robot is heading to
 ``live``        the number of live slots / n_slots (the same on every slot)
 
+With ``tour=True``, one more (:data:`TOUR_FEATURE`), after those:
+
+``tour``        Euclidean length of the nearest-neighbour tour that starts at the slot's target
+                and visits every other live slot's target (:func:`tour_lengths`): how well
+                going there first fits a route through all the nearby frontiers
+
 With teammates observed (``teammates`` other than ``none``), three more per slot
 (:data:`TEAM_FEATURES`), whatever the team's size:
 
@@ -36,6 +42,7 @@ EXPLORER_FEATURES = (
     "path", "distance", "d_row", "d_col", "size", "gain", "isolation", "extra_path", "current",
     "live",
 )  # fmt: skip
+TOUR_FEATURE = "tour"
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
 _BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
@@ -83,6 +90,32 @@ def explorer_features(slots: SlotArrays, positions: np.ndarray, heading: np.ndar
     )
     features[~valid] = 0.0
     return features.astype(np.float32).reshape(count, n_slots, len(EXPLORER_FEATURES))
+
+
+def tour_lengths(slots: SlotArrays) -> np.ndarray:
+    """(M, n_slots, 1) :data:`TOUR_FEATURE` of M robots, in :data:`CELLS` units (0 on padding
+    slots): from each live slot's target, the greedy nearest-neighbour tour (Euclidean,
+    ties to the lower slot) through the targets of every other live slot."""
+    valid = slots.valid
+    count, n_slots = valid.shape
+    target = slots.target.astype(np.float64)
+    apart = np.linalg.norm(target[:, :, None, :] - target[:, None, :, :], axis=-1)
+    apart = np.where(valid[:, None, :], apart, np.inf)  # (M, S, S): never to a padding slot
+    robots = np.arange(count)[:, None]
+    starts = np.arange(n_slots)[None, :]
+    at = np.broadcast_to(starts, (count, n_slots)).copy()  # each tour's current slot
+    visited = ~valid[:, None, :] | (np.arange(n_slots)[None, None, :] == at[..., None])
+    length = np.zeros((count, n_slots))
+    for _ in range(n_slots - 1):
+        step = np.where(visited, np.inf, apart[robots, at])  # (M, S starts, S next)
+        nearest = step.argmin(axis=2)
+        gap = np.take_along_axis(step, nearest[..., None], axis=2)[..., 0]
+        going = np.isfinite(gap)
+        length += np.where(going, gap, 0.0)
+        at = np.where(going, nearest, at)
+        visited |= going[..., None] & (np.arange(n_slots)[None, None, :] == nearest[..., None])
+    length[~valid] = 0.0
+    return (length / CELLS).astype(np.float32)[..., None]
 
 
 def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:

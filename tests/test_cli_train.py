@@ -216,7 +216,7 @@ def test_train_the_explorer_on_families_and_benchmark_it(tmp_path: Path, capsys)
     scorer, resumes, and the benchmark runs the model on validation episodes of every size."""
     run_dir = tmp_path / "explorer"
     overrides = ["--set", "dqn.learning_starts=50", "--set", "train.n_envs=1", "--no-progress"]
-    assert main(["train", "explorer", "--steps", "300", "--out", str(run_dir), *overrides]) == 0
+    assert main(["train", "explorer-dqn", "--steps", "300", "--out", str(run_dir), *overrides]) == 0
     meta = json.loads((run_dir / "model.json").read_text())
     assert meta["observation_layout"]["features"] == "explorer"
     assert "height" not in meta["observation_layout"]

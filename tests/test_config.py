@@ -69,6 +69,7 @@ BAD_VALUES = [
     ("sort_by_distance", "no", "sort_by_distance"),
     ("action_mask", 0, "action_mask"),
     ("normalize", "false", "normalize"),
+    ("tour", 1, "tour"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),
     ("explore_threshold", 1.01, "explore_threshold"),

@@ -11,7 +11,7 @@ import frontier_marl
 from frontier_marl.config import make_config
 from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.rewards import StepEvents, step_outcome
-from frontier_marl.slot_features import CELLS, EXPLORER_FEATURES, explorer_features
+from frontier_marl.slot_features import CELLS, EXPLORER_FEATURES, explorer_features, tour_lengths
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown"}
 
@@ -45,6 +45,27 @@ def test_explorer_features_on_a_hand_made_table() -> None:
     assert features[:, column["live"]].tolist() == [0.5, 0.5, 0, 0]
     assert features[:, column["d_row"]].tolist() == pytest.approx([0, 3 / CELLS, 0, 0])
     assert not features[2:].any()  # padding slots are zeros
+
+
+def test_tour_lengths_on_a_hand_made_table() -> None:
+    line = _table([(0, 0), (0, 3), (0, 10)], [1, 2, 3])
+    alone = _table([(5, 5)], [4])
+    tours = tour_lengths(SlotArrays.stack([line, alone]))
+    assert tours.shape == (2, 4, 1)
+    # from (0,0): 3 then 7; from (0,3): back 3 then 10; from (0,10): 7 then 3; padding 0
+    assert tours[0, :, 0].tolist() == pytest.approx([10 / CELLS, 13 / CELLS, 10 / CELLS, 0])
+    assert not tours[1].any()  # a single live slot has nowhere else to go
+
+
+def test_the_tour_feature_extends_the_explorer_layout_and_needs_it() -> None:
+    env = frontier_marl.parallel_env(**EXPLORER, tour=True)
+    observations, _ = env.reset(seed=3)
+    slots = observations["robot_0"]["slots"]
+    assert slots.shape == (6, len(EXPLORER_FEATURES) + 1)
+    without = frontier_marl.parallel_env(**EXPLORER).reset(seed=3)[0]["robot_0"]["slots"]
+    assert np.array_equal(slots[:, :-1], without)
+    with pytest.raises(ValueError, match="tour=True needs features='explorer'"):
+        make_config("thesis-20x20", tour=True)
 
 
 def test_team_features_on_a_hand_made_table() -> None:
@@ -137,19 +158,27 @@ def test_batched_and_single_explorer_observations_agree() -> None:
         assert rewards[0] == single_rewards["robot_0"]
 
 
-def _slot_model(n_envs: int = 2):  # noqa: ANN202
+def _slot_model(n_envs: int = 2, attention_heads: int = 0):  # noqa: ANN202
     from frontier_marl.training.batched_vec_env import make_batched_vec_env
     from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
 
     torch.set_num_threads(1)
     cfg = make_config("thesis-20x20", reward="travel", **EXPLORER)
     env = make_batched_vec_env({"config": cfg}, n_envs, seed=0)
-    model = MaskedDQN(SlotDQNPolicy, env, learning_starts=50, buffer_size=500, batch_size=16)
+    model = MaskedDQN(
+        SlotDQNPolicy,
+        env,
+        learning_starts=50,
+        buffer_size=500,
+        batch_size=16,
+        policy_kwargs={"attention_heads": attention_heads},
+    )
     return model, env
 
 
-def test_slot_q_network_is_permutation_equivariant_and_masks() -> None:
-    model, env = _slot_model()
+@pytest.mark.parametrize("attention_heads", [0, 4])
+def test_slot_q_network_is_permutation_equivariant_and_masks(attention_heads: int) -> None:
+    model, env = _slot_model(attention_heads=attention_heads)
     observation = env.reset()
     observation["action_mask"][:, 0] = 1
     order = np.random.default_rng(0).permutation(observation["slots"].shape[1])
@@ -159,6 +188,33 @@ def test_slot_q_network_is_permutation_equivariant_and_masks() -> None:
     assert torch.allclose(q_values[:, order], q_shuffled, atol=1e-5)
     masked = torch.as_tensor(observation["action_mask"] == 0)
     assert (q_values[masked] <= -1e8).all() and (q_values[~masked] > -1e8).all()
+
+
+def test_attention_reaches_the_q_values_and_survives_save_and_load(tmp_path) -> None:
+    from frontier_marl.training.slot_policy import MaskedDQN
+
+    model, env = _slot_model(attention_heads=4)
+    observation = env.reset()
+    tensor = model.policy.obs_to_tensor(observation)[0]
+    before = model.q_net(tensor)
+    model.save(tmp_path / "model.zip")
+    loaded = MaskedDQN.load(tmp_path / "model.zip")
+    assert loaded.policy.q_net.q_net.attend is not None
+    assert torch.allclose(loaded.q_net(tensor), before)
+    # a slot's Q-value depends on the other slots' features through attention, not pooling only
+    attend = model.q_net.q_net.attend
+    with torch.no_grad():
+        attend.out_proj.weight.zero_()
+        attend.out_proj.bias.zero_()
+    assert not torch.allclose(model.q_net(tensor), before)
+
+
+@pytest.mark.parametrize("heads", [-1, 3, 1.5, True])
+def test_bad_attention_heads_are_refused(heads: object) -> None:
+    from frontier_marl.training.slot_policy import SlotScorer
+
+    with pytest.raises(ValueError, match="attention_heads"):
+        SlotScorer(6, 10, [16, 16], torch.nn.ReLU, heads)  # type: ignore[arg-type]
 
 
 def test_masked_dqn_only_ever_picks_valid_slots() -> None:

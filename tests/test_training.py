@@ -235,6 +235,7 @@ def test_config_by_name_and_overrides() -> None:
         ("dqn.seed=3", "seed"),
         ("train.n_envs=0", "n_envs"),
         ("train.bootstrap_truncations=1", "bootstrap_truncations"),
+        ("train.skip_forced_steps=1", "skip_forced_steps"),
         ("dqn.train_freq=-1", "train_freq"),
         ("exploration_fraction=1.5", "exploration_fraction"),
         ("dqn.learning_rate=0", "learning_rate"),
@@ -246,6 +247,12 @@ def test_config_by_name_and_overrides() -> None:
 def test_bad_overrides_name_the_problem(override: str, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         load_experiment("config01", [override])
+
+
+def test_skipping_forced_steps_needs_the_batched_env() -> None:
+    overrides = ["train.skip_forced_steps=true", "train.vec_env=supersuit"]
+    with pytest.raises(ValueError, match="skip_forced_steps needs train.vec_env"):
+        load_experiment("config01", overrides)
 
 
 # --------------------------------------------------------------------------- training runs

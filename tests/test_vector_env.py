@@ -281,3 +281,51 @@ def test_bad_actions_are_refused_by_name() -> None:
         vector_env(2, info="everything")
     with pytest.raises(ValueError, match="n_agents"):
         vector_env(2, n_agents=0)
+
+
+def _episodes_of_first_valid_policy(skip: bool, n_agents: int) -> tuple[list[list], int]:
+    """Per world, (return, cells travelled, end reason) of its first three episodes when every
+    robot takes its first valid slot; also the number of steps called."""
+    vec = vector_env(
+        3,
+        autoreset_mode="same-step",
+        skip_forced_steps=skip,
+        n_agents=n_agents,
+        map_mode="dynamic",
+        features="explorer",
+        commit="until-reached",
+        reward="travel",
+    )
+    k = vec.n_agents
+    _, infos = vec.reset(seed=11)
+    returns = np.zeros(vec.num_envs)
+    episodes: list[list] = [[] for _ in range(vec.n_worlds)]
+    calls = 0
+    fresh = np.ones(vec.n_worlds, dtype=bool)  # episodes may start with a single choice
+    while min(len(e) for e in episodes) < 3:
+        masks = infos["action_mask"]
+        if skip:  # every world that did not just reset offers some robot a choice
+            choice = (masks.reshape(vec.n_worlds, k, -1).sum(axis=2) > 1).any(axis=1)
+            assert (choice | fresh).all()
+        _, rewards, terminated, truncated, infos = vec.step(masks.argmax(axis=1))
+        calls += 1
+        returns += rewards
+        fresh = (terminated | truncated)[::k]
+        for j in np.flatnonzero(fresh).tolist():
+            final = infos["final_info"][j * k]
+            episodes[j].append((round(returns[j * k], 9), final["travelled"], final["end_reason"]))
+            returns[j * k : (j + 1) * k] = 0.0
+    return [e[:3] for e in episodes], calls
+
+
+@pytest.mark.parametrize("n_agents", [1, 2])
+def test_skipping_forced_steps_plays_the_same_episodes_in_fewer_steps(n_agents: int) -> None:
+    stepped, every_step = _episodes_of_first_valid_policy(False, n_agents)
+    skipped, decisions = _episodes_of_first_valid_policy(True, n_agents)
+    assert skipped == stepped
+    assert decisions < every_step
+
+
+def test_skip_forced_steps_must_be_a_bool() -> None:
+    with pytest.raises(ValueError, match="skip_forced_steps"):
+        vector_env(1, skip_forced_steps=1)

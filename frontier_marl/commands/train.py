@@ -143,11 +143,21 @@ def run(args: argparse.Namespace) -> int:
     else:
         world = f"{cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map"
         worlds = f"{settings.n_envs} world(s)"
+    budget = (
+        f"{settings.total_timesteps} steps, seed {settings.seed}, {worlds} ({settings.vec_env})"
+    )
+    if settings.algorithm == "cem":
+        from frontier_marl.training.cem import CEMSettings
+
+        cem = CEMSettings(**experiment.cem)
+        budget = (
+            f"cross-entropy method: {cem.generations} generations of {cem.population} weight "
+            f"vectors, {cem.episodes} training episodes per family each, seed {settings.seed}"
+        )
     print(
         f"{experiment.name}: {experiment.description}\n"
         f"  env: {world}, reward={cfg.reward.kind}, observation={cfg.observation}\n"
-        f"  {settings.total_timesteps} steps, seed {settings.seed}, {worlds} "
-        f"({settings.vec_env}){start}\n"
+        f"  {budget}{start}\n"
         f"  run folder: {run_dir}"
     )
     try:

@@ -43,8 +43,16 @@ class FrontierVectorEnv(VectorEnv):
     ``end_reason``; ``full`` adds ``position``, ``target`` (row -1: none), ``padding`` and
     ``oscillation``.
 
-    **Arguments.** ``num_envs`` (worlds, >= 1), ``preset``, ``info``, ``autoreset_mode``, and
-    every keyword of :class:`~frontier_marl.envs.parallel.FrontierParallelEnv`.
+    **Forced steps.** With ``skip_forced_steps=True`` a step returns only when a decision is
+    due: after the actions are applied, every world whose robots each have a single valid slot
+    (held by a commitment, or one cluster left) walks on with it until its robots have a choice
+    again or its episode ends. Rewards are summed over the steps played; infos describe the
+    last one. The robots walk exactly as a policy choosing the only valid slot would (a
+    semi-MDP view of the same episodes, for training).
+
+    **Arguments.** ``num_envs`` (worlds, >= 1), ``preset``, ``info``, ``autoreset_mode``,
+    ``skip_forced_steps``, and every keyword of
+    :class:`~frontier_marl.envs.parallel.FrontierParallelEnv`.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -55,8 +63,11 @@ class FrontierVectorEnv(VectorEnv):
         preset: str | None = "thesis-20x20",
         info: str = "minimal",
         autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+        skip_forced_steps: bool = False,
         **kwargs: Any,
     ) -> None:
+        if not isinstance(skip_forced_steps, bool):
+            raise ValueError(f"skip_forced_steps must be true or false, got {skip_forced_steps!r}")
         if info not in VECTOR_INFO_LEVELS:
             raise ValueError(f"info must be one of {list(VECTOR_INFO_LEVELS)}, got {info!r}")
         modes = {mode.value: mode for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)}
@@ -75,6 +86,7 @@ class FrontierVectorEnv(VectorEnv):
         self.autoreset_mode = mode
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.info_level = info
+        self.skip_forced_steps = skip_forced_steps
         self.n_worlds, self.n_agents = self.mdp.n_worlds, self.mdp.n_agents
         self.num_envs = self.n_worlds * self.n_agents
         self.single_observation_space = self.mdp.encoder.space
@@ -107,12 +119,12 @@ class FrontierVectorEnv(VectorEnv):
         infos: dict[str, Any] = {}
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
             restart = np.flatnonzero(mdp.done)
-            mdp.step(chosen, ~mdp.done)
+            self._step_worlds(chosen, ~mdp.done)
             if len(restart):
                 mdp.reset_worlds(restart)
             observations = self._observations()
         else:
-            mdp.step(chosen, ~mdp.done)
+            self._step_worlds(chosen, ~mdp.done)
             ended = np.flatnonzero(mdp.done)
             observations = self._observations()
             if len(ended):
@@ -130,6 +142,11 @@ class FrontierVectorEnv(VectorEnv):
         pass
 
     # ------------------------------------------------------------------ helpers
+    def _step_worlds(self, actions: np.ndarray, active: np.ndarray) -> None:
+        self.mdp.step(actions, active)
+        if self.skip_forced_steps:
+            self.mdp.play_forced()
+
     def _world_seeds(self, seed: int | list[int | None] | None) -> list[int | None]:
         n = self.n_worlds
         if seed is None:

@@ -16,6 +16,9 @@ A config file has four parts (every one optional except ``name``)::
     total_timesteps = 1_000_000
     seed = 0
 
+and, with ``train.algorithm = "cem"``, a ``[cem]`` section instead of ``[dqn]``
+(:class:`~frontier_marl.training.cem.CEMSettings`).
+
 Overrides use ``section.key=value`` (``env.reward=reward1``, ``dqn.learning_rate=1e-4``,
 ``train.n_envs=2``); a bare ``key=value`` goes to the one section that knows the key. Values
 are parsed as TOML (``1e-4``, ``true``, ``[64, 64]``), else kept as strings.
@@ -36,9 +39,12 @@ from typing import Any
 from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.thesis import DQN_HYPERPARAMETERS
+from frontier_marl.training.cem import CEM_KEYS, CEMSettings
 from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
 
 __all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
+
+SECTIONS = ("env", "dqn", "train", "cem")
 
 #: The thesis's final DQN hyperparameters; everything else is SB3's default.
 THESIS_DQN = DQN_HYPERPARAMETERS
@@ -65,6 +71,7 @@ class Experiment:
     env: dict[str, Any] = field(default_factory=dict)
     dqn: dict[str, Any] = field(default_factory=lambda: dict(THESIS_DQN))
     train: TrainSettings = field(default_factory=TrainSettings)
+    cem: dict[str, Any] = field(default_factory=dict)
     source: str | None = None
 
     def env_config(self) -> EnvConfig:
@@ -99,6 +106,7 @@ class Experiment:
                 "families": list(self.train.families),
                 "agents": list(self.train.agents),
             },
+            **({"cem": dict(self.cem)} if self.cem else {}),
         }
 
 
@@ -112,16 +120,16 @@ def dqn_keys() -> set[str]:
 def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> Experiment:
     """Build and validate an :class:`Experiment` from a parsed config file."""
     where = f" in {source}" if source else ""
-    unknown = set(data) - {"name", "description", "env", "dqn", "train"}
+    unknown = set(data) - {"name", "description", *SECTIONS}
     if unknown:
         raise ValueError(
             f"unknown top-level key(s) {sorted(unknown)}{where}; "
-            "allowed: name, description, [env], [dqn], [train]"
+            "allowed: name, description, [env], [dqn], [train], [cem]"
         )
     name = data.get("name")
     if not isinstance(name, str) or not name:
         raise ValueError(f"an experiment needs a non-empty string 'name'{where}")
-    for section in ("env", "dqn", "train"):
+    for section in SECTIONS:
         if not isinstance(data.get(section, {}), Mapping):
             raise ValueError(f"[{section}] must be a table{where}")
     env = dict(data.get("env", {}))
@@ -145,6 +153,13 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
             f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
         )
     _check_dqn(dqn, where)
+    cem = dict(data.get("cem", {}))
+    bad_cem = set(cem) - CEM_KEYS
+    if bad_cem:
+        raise ValueError(
+            f"unknown [cem] key(s) {sorted(bad_cem)}{where}; allowed: {sorted(CEM_KEYS)}"
+        )
+    CEMSettings(**cem)  # raises naming a bad value
     if isinstance(dqn.get("train_freq"), list):
         dqn["train_freq"] = tuple(dqn["train_freq"])  # SB3 wants (n, "step"|"episode")
     experiment = Experiment(
@@ -153,6 +168,7 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         env=env,
         dqn=dqn,
         train=TrainSettings(**train_kw),
+        cem=cem,
         source=source,
     )
     try:
@@ -213,9 +229,9 @@ def parse_override(text: str) -> tuple[str, str, Any]:
     value = _parse_value(raw.strip())
     if "." in key:
         section, name = key.split(".", 1)
-        if section not in ("env", "dqn", "train"):
+        if section not in SECTIONS:
             raise ValueError(
-                f"override section must be env, dqn or train, got {section!r} in {text!r}"
+                f"override section must be env, dqn, train or cem, got {section!r} in {text!r}"
             )
         return section, name, value
     owners = [
@@ -223,6 +239,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
         for section, keys in (
             ("train", TRAIN_KEYS),
             ("dqn", dqn_keys()),
+            ("cem", CEM_KEYS),
             ("env", set(config_keys())),
         )
         if key in keys

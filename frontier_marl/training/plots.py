@@ -188,7 +188,10 @@ def plot_action_comparison(
 
 
 def plot_family_validation(
-    records: Sequence[Mapping[str, Any]], path: str | os.PathLike[str], title: str | None = None
+    records: Sequence[Mapping[str, Any]],
+    path: str | os.PathLike[str],
+    title: str | None = None,
+    xlabel: str = "training steps",
 ) -> None:
     """T99 (a team: the makespan) relative to the reference heuristic on the validation
     episodes, per family and overall, against training steps (records of
@@ -210,7 +213,7 @@ def plot_family_validation(
         ax.plot(steps, overall, color="black", linewidth=2.0, label="all families")
         ax.axhline(0.0, color="grey", linewidth=0.8)
         ax.axhline(-5.0, color="green", linewidth=0.8, linestyle="--", label="-5 % (target)")
-        ax.set_xlabel("training steps")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel(f"{metric} vs {reference} (%)")
         ax.set_title(title or f"validation: {metric} to 99 % coverage against {reference}")
         ax.legend(fontsize=7)

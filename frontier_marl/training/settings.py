@@ -8,6 +8,7 @@ from dataclasses import dataclass
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
 POLICIES = ("auto", "slot-scorer")
+ALGORITHMS = ("dqn", "cem")
 
 
 @dataclass(frozen=True)
@@ -53,6 +54,14 @@ class TrainSettings:
         agents: team sizes to train on with ``families``: ``n_envs`` worlds of every family
             with every team size (one parameter-shared model acts for each robot). The first
             size is the one validated.
+        skip_forced_steps: train on decisions only: steps where every robot of a world has a
+            single valid slot (a commitment, one cluster left) are played by the batched env
+            and their rewards summed into the decision's transition (a semi-MDP; ``gamma``
+            then discounts per decision). ``total_timesteps`` counts decisions.
+        algorithm: ``dqn`` (SB3 DQN with ``[dqn]``) or ``cem``: the cross-entropy method on a
+            linear slot scorer with ``[cem]`` (:mod:`frontier_marl.training.cem`; one robot,
+            ``families`` and the explorer features needed; ``total_timesteps``, checkpoints
+            and ``[dqn]`` unused).
     """
 
     total_timesteps: int = 1_000_000
@@ -74,6 +83,8 @@ class TrainSettings:
     policy: str = "auto"
     families: tuple[str, ...] = ()
     agents: tuple[int, ...] = (1,)
+    skip_forced_steps: bool = False
+    algorithm: str = "dqn"
 
     def __post_init__(self) -> None:
         for name, low in (
@@ -93,6 +104,12 @@ class TrainSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+        if self.algorithm not in ALGORITHMS:
+            raise ValueError(
+                f"train.algorithm must be one of {list(ALGORITHMS)}, got {self.algorithm!r}"
+            )
+        if self.algorithm == "cem" and (not self.families or self.agents != (1,)):
+            raise ValueError("train.algorithm = 'cem' needs train.families and one robot")
         if self.policy not in POLICIES:
             raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
         if self.families:
@@ -109,11 +126,11 @@ class TrainSettings:
             raise ValueError("train.agents needs train.families (the team sizes of their worlds)")
         if self.vec_env not in VEC_ENVS:
             raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
-        if not isinstance(self.bootstrap_truncations, bool):
-            raise ValueError(
-                "train.bootstrap_truncations must be true or false, "
-                f"got {self.bootstrap_truncations!r}"
-            )
+        for name in ("bootstrap_truncations", "skip_forced_steps"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"train.{name} must be true or false, got {getattr(self, name)!r}")
+        if self.skip_forced_steps and self.vec_env != "batched":
+            raise ValueError("train.skip_forced_steps needs train.vec_env = 'batched'")
         if self.validate_every and self.eval_episodes:
             first = self.validation_seed
             validation = range(first, first + self.validation_episodes)

@@ -52,16 +52,35 @@ class SlotExtractor(BaseFeaturesExtractor):
 
 class SlotScorer(nn.Module):
     """Q-values of S slots from ``(B, S * F + S)`` (features, then mask): a shared encoder
-    per slot, mean and max pooling over the live slots, a shared advantage scorer per slot and
-    a state value from the pooled context (a dueling head)."""
+    per slot, optionally one layer of self-attention among the live slots (``attention_heads``
+    > 0: each slot sees the others pairwise, not only through the pooled context), mean and
+    max pooling over the live slots, a shared advantage scorer per slot and a state value
+    from the pooled context (a dueling head)."""
 
     def __init__(
-        self, n_slots: int, n_features: int, hidden: list[int], activation: type[nn.Module]
+        self,
+        n_slots: int,
+        n_features: int,
+        hidden: list[int],
+        activation: type[nn.Module],
+        attention_heads: int = 0,
     ) -> None:
         super().__init__()
         self.n_slots, self.n_features = n_slots, n_features
         width = hidden[-1]
+        if isinstance(attention_heads, bool) or not isinstance(attention_heads, int):
+            raise ValueError(f"attention_heads must be an integer >= 0, got {attention_heads!r}")
+        if attention_heads < 0 or (attention_heads and width % attention_heads):
+            raise ValueError(
+                f"attention_heads must be >= 0 and divide the last hidden size {width}, "
+                f"got {attention_heads}"
+            )
         self.encode = _mlp([n_features, *hidden], activation)
+        self.attend = (
+            nn.MultiheadAttention(width, attention_heads, batch_first=True)
+            if attention_heads
+            else None
+        )
         self.score = nn.Sequential(_mlp([3 * width, *hidden], activation), nn.Linear(width, 1))
         self.value = nn.Sequential(_mlp([2 * width, width], activation), nn.Linear(width, 1))
 
@@ -70,6 +89,11 @@ class SlotScorer(nn.Module):
         slots = flat[:, : s * f].reshape(batch, s, f)
         mask = flat[:, s * f :] > 0.5
         encoded = self.encode(slots)  # (B, S, H)
+        if self.attend is not None:
+            # rows without a live slot (never chosen from) attend to every slot, not to none
+            ignored = ~mask & mask.any(dim=1, keepdim=True)
+            attended, _ = self.attend(encoded, encoded, encoded, key_padding_mask=ignored)
+            encoded = encoded + attended
         live = mask.unsqueeze(-1)
         count = live.sum(dim=1).clamp(min=1)
         mean = (encoded * live).sum(dim=1) / count
@@ -85,28 +109,75 @@ class SlotScorer(nn.Module):
         return q_values.masked_fill(~mask, MASKED_Q)
 
 
-class SlotQNetwork(QNetwork):
-    """SB3's ``QNetwork`` with :class:`SlotScorer` as its head (``net_arch``: hidden sizes)."""
+class LinearSlotScorer(nn.Module):
+    """Q-values of S slots from ``(B, S * F + S)``: one weight per feature, shared by every
+    slot (``weight`` (F,)), so a slot's score is the dot product of its features with it.
+    Permutation-equivariant like :class:`SlotScorer`; what the cross-entropy method
+    (:mod:`frontier_marl.training.cem`) trains."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(self, n_slots: int, n_features: int) -> None:
+        super().__init__()
+        self.n_slots, self.n_features = n_slots, n_features
+        self.weight = nn.Parameter(th.zeros(n_features))
+
+    def forward(self, flat: th.Tensor) -> th.Tensor:
+        s, f = self.n_slots, self.n_features
+        slots = flat[:, : s * f].reshape(-1, s, f)
+        mask = flat[:, s * f :] > 0.5
+        return (slots @ self.weight).masked_fill(~mask, MASKED_Q)
+
+
+SCORERS = ("mlp", "linear")
+
+
+class SlotQNetwork(QNetwork):
+    """SB3's ``QNetwork`` with a slot scorer as its head: :class:`SlotScorer` (``scorer =
+    "mlp"``; ``net_arch``: hidden sizes) or :class:`LinearSlotScorer` (``"linear"``)."""
+
+    def __init__(
+        self, *args: Any, attention_heads: int = 0, scorer: str = "mlp", **kwargs: Any
+    ) -> None:
         super().__init__(*args, **kwargs)
         extractor = self.features_extractor
         assert isinstance(extractor, SlotExtractor)
+        if scorer not in SCORERS:
+            raise ValueError(f"scorer must be one of {list(SCORERS)}, got {scorer!r}")
+        if scorer == "linear":
+            if attention_heads:
+                raise ValueError("attention_heads needs scorer='mlp'")
+            self.q_net = LinearSlotScorer(extractor.n_slots, extractor.n_features)
+            return
         self.q_net = SlotScorer(
-            extractor.n_slots, extractor.n_features, list(self.net_arch), self.activation_fn
+            extractor.n_slots,
+            extractor.n_features,
+            list(self.net_arch),
+            self.activation_fn,
+            attention_heads,
         )
 
 
 class SlotDQNPolicy(DQNPolicy):
     """DQN policy with :class:`SlotQNetwork` (online and target)."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(
+        self, *args: Any, attention_heads: int = 0, scorer: str = "mlp", **kwargs: Any
+    ) -> None:
         kwargs.setdefault("features_extractor_class", SlotExtractor)
+        # read by make_q_net during super().__init__
+        self.attention_heads, self.scorer = attention_heads, scorer
         super().__init__(*args, **kwargs)
 
     def make_q_net(self) -> SlotQNetwork:
         net_args = self._update_features_extractor(self.net_args, features_extractor=None)
-        return SlotQNetwork(**net_args).to(self.device)
+        head = {"attention_heads": self.attention_heads, "scorer": self.scorer}
+        return SlotQNetwork(**net_args, **head).to(self.device)
+
+    def _get_constructor_parameters(self) -> dict[str, Any]:
+        return {
+            **super()._get_constructor_parameters(),
+            "attention_heads": self.attention_heads,
+            "scorer": self.scorer,
+        }
 
 
 class MaskedDQN(DQN):

@@ -126,9 +126,11 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
 
     settings = experiment.train
     bootstrap = settings.bootstrap_truncations
+    skip = {"skip_forced_steps": True} if settings.skip_forced_steps else {}
     if not settings.families:
         make = make_batched_vec_env if settings.vec_env == "batched" else make_vec_env
-        return make({"config": experiment.env_config()}, settings.n_envs, seed, bootstrap)
+        kwargs = {"config": experiment.env_config(), **skip}
+        return make(kwargs, settings.n_envs, seed, bootstrap)
     from stable_baselines3.common.vec_env import VecMonitor
 
     from frontier_marl.evaluation.families import family
@@ -138,7 +140,7 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
     for i, (name, cfg) in enumerate(zip(names, experiment.env_configs(), strict=True)):
         seeds = family(name).train
         part = make_batched_vec_env(
-            {"config": cfg}, settings.n_envs, seed + 1000 * i, bootstrap, seed_range=seeds
+            {"config": cfg, **skip}, settings.n_envs, seed + 1000 * i, bootstrap, seed_range=seeds
         )
         parts.append(part.venv)  # one VecMonitor around the mix
     return VecMonitor(MixedVecEnv(parts))
@@ -185,6 +187,12 @@ def train(
         )
     run_dir.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(settings.torch_threads)
+    if settings.algorithm == "cem":
+        from frontier_marl.training.cem import train_cem
+
+        if checkpoint is not None:
+            raise ValueError("a train.algorithm = 'cem' run cannot be resumed: start it again")
+        return train_cem(experiment, run_dir, progress_bar)
 
     cfg = experiment.env_config()
     start_step = 0 if checkpoint is None else checkpoint.step

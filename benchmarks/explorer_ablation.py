@@ -1,0 +1,83 @@
+"""What each part of `explorer` is worth (docs/beyond-the-thesis.md, "Ablation").
+
+Scores, on the same validation episodes of every family (seeds 800,000+, never the held-out
+ones), with ``frontier-marl benchmark``:
+
+* ``nearest-path``, the best heuristic (every reachable cluster);
+* ``path-only``: the linear slot scorer with the path weight alone, nearest-path among the
+  explorer's 12 slots (where CEM starts);
+* ``tour-rule``: the path weight plus a hand-set tour weight of -0.5, no learning;
+* ``explorer-dqn``: the DQN-trained slot scorer (no tour feature);
+* ``explorer``: the shipped CEM-trained linear scorer (with the tour feature);
+* any further model given with ``--models`` (e.g. a CEM run without the tour feature:
+  ``frontier-marl train explorer --set env.tour=false --out runs/explorer-no-tour``).
+
+    python benchmarks/explorer_ablation.py --episodes 64 \
+        --json training/results/explorer/ablation.json
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from frontier_marl.cli import main as cli
+from frontier_marl.training.cem import feature_names, linear_model
+from frontier_marl.training.experiment import load_experiment
+from frontier_marl.training.metadata import build_metadata, save_metadata
+
+HAND_SET = {"path-only": {"path": -1.0}, "tour-rule": {"path": -1.0, "tour": -0.5}}
+
+
+def save_hand_set(out: Path) -> list[str]:
+    """Save the hand-set linear scorers under ``out``; returns their folders."""
+    experiment = load_experiment("explorer")
+    cfg = experiment.env_config()
+    names = feature_names(cfg)
+    folders = []
+    for label, weights in HAND_SET.items():
+        vector = np.array([weights.get(name, 0.0) for name in names])
+        model = linear_model(cfg, vector)
+        folder = out / label
+        folder.mkdir(parents=True, exist_ok=True)
+        model.save(folder / "model.zip")
+        meta = build_metadata(
+            cfg,
+            model.observation_space,
+            model.action_space,
+            policy="SlotPolicy",
+            num_timesteps=0,
+            experiment=experiment.to_dict(),
+            extra={
+                "trained_by": "hand-set",
+                "weights": dict(zip(names, vector.tolist(), strict=True)),
+            },
+        )
+        save_metadata(meta, folder / "model.json")
+        folders.append(str(folder))
+    return folders
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--episodes", type=int, default=64, help="validation episodes per family")
+    parser.add_argument("--models", default="", help="comma-separated extra model folders")
+    parser.add_argument("--out", type=Path, default=Path("runs/explorer-ablation"))
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    policies = ["nearest-path", *save_hand_set(args.out), "explorer-dqn", "explorer"]
+    policies += [m for m in args.models.split(",") if m]
+    command = ["benchmark", "--split", "validation", "--episodes", str(args.episodes)]
+    command += ["--policies", ",".join(policies)]
+    if args.json is not None:
+        command += ["--json", str(args.json)]
+    if args.no_progress:
+        command.append("--no-progress")
+    return cli(command)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

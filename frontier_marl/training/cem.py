@@ -1,0 +1,296 @@
+"""The cross-entropy method on a linear slot scorer (``train.algorithm = "cem"``).
+
+The policy scores every valid slot by the dot product of its features with one weight vector
+(:class:`~frontier_marl.training.slot_policy.LinearSlotScorer`) and takes the best slot. CEM
+searches the weights directly on the benchmark's metric, T99, with no value function to
+learn: each generation draws ``population`` weight vectors around the current mean (the mean
+itself first), plays each on the same fresh episodes of every training family (``episodes``
+per family, seeds drawn from the family's training range), scores each by its mean
+per-episode T99 relative to the path-only scorer (nearest-path among the slots) on those same
+episodes (an episode that misses 99 % counts as +100 %), and moves the mean and the spread to
+the ``elite`` best. The ``path`` weight keeps its initial value: multiplying every weight by
+a positive number changes no choice, so one weight fixes the scale.
+
+Episodes are played on the batched vector env with ``skip_forced_steps``: only real decisions
+reach the scorer. After each generation the mean is validated like a DQN policy
+(:class:`~frontier_marl.training.family_validation.FamilyValidator`, validation seeds) and the
+best one is kept in ``RUN/best/``; ``RUN/model.zip`` is the last mean. Both are SB3 models
+(``MaskedDQN`` with the linear scorer), usable wherever a model is.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.slot_features import EXPLORER_FEATURES, TEAM_FEATURES, TOUR_FEATURE
+
+if TYPE_CHECKING:
+    from frontier_marl.training.experiment import Experiment
+    from frontier_marl.training.train import TrainResult
+
+LOG_FILE = "cem.jsonl"
+FAILURE = 1.0  # the relative T99 of an episode that misses 99 %
+
+
+@dataclass(frozen=True)
+class CEMSettings:
+    """The ``[cem]`` section of an experiment config.
+
+    Attributes:
+        generations: CEM iterations.
+        population: weight vectors tried per generation (the current mean among them).
+        elite: the best of them that the next mean and spread are fitted to.
+        episodes: training episodes per family per generation (fresh every generation).
+        sigma: initial spread of every free weight.
+        min_sigma: floor of the spread (keeps the search from collapsing early).
+        init: initial mean weight by feature name (the others start at 0); must name ``path``,
+            whose weight fixes the scale and is not searched.
+    """
+
+    generations: int = 20
+    population: int = 12
+    elite: int = 4
+    episodes: int = 12
+    sigma: float = 0.3
+    min_sigma: float = 0.03
+    init: Mapping[str, float] = field(default_factory=lambda: {"path": -1.0})
+
+    def __post_init__(self) -> None:
+        for name in ("generations", "population", "elite", "episodes"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"cem.{name} must be an integer >= 1, got {value!r}")
+        if self.elite > self.population:
+            raise ValueError(
+                f"cem.elite ({self.elite}) must not exceed cem.population ({self.population})"
+            )
+        for name in ("sigma", "min_sigma"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+                raise ValueError(f"cem.{name} must be a number > 0, got {value!r}")
+        if not isinstance(self.init, Mapping) or not isinstance(self.init.get("path"), int | float):
+            raise ValueError(
+                f"cem.init must map feature names to weights with 'path', got {self.init!r}"
+            )
+        if self.init["path"] >= 0:
+            raise ValueError(
+                f"cem.init.path must be < 0 (shorter paths score higher), got {self.init['path']}"
+            )
+
+
+CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
+
+
+def feature_names(cfg: EnvConfig) -> list[str]:
+    """The names of the per-slot features of ``cfg``'s explorer layout, in order."""
+    obs = cfg.observation
+    if obs.features != "explorer":
+        raise ValueError("the linear slot scorer needs features = 'explorer'")
+    names = list(EXPLORER_FEATURES) + ([TOUR_FEATURE] if obs.tour else [])
+    return names + (list(TEAM_FEATURES) if obs.teammates != "none" else [])
+
+
+def initial_weights(settings: CEMSettings, names: list[str]) -> np.ndarray:
+    unknown = set(settings.init) - set(names)
+    if unknown:
+        raise ValueError(f"cem.init names unknown feature(s) {sorted(unknown)}; features: {names}")
+    return np.array([float(settings.init.get(name, 0.0)) for name in names])
+
+
+def play_t99(cfg: EnvConfig, seeds: list[int], weights: np.ndarray) -> tuple[np.ndarray, int]:
+    """One robot's T99 on the episodes reset with ``seeds`` (NaN where 99 % was not reached)
+    when it takes the valid slot of highest ``features @ weights``; also the decisions made."""
+    from frontier_marl.envs.vector import FrontierVectorEnv
+
+    if cfg.n_agents != 1:
+        raise ValueError("the cross-entropy method trains one robot (train.agents = [1])")
+    env = FrontierVectorEnv(num_envs=len(seeds), config=cfg, skip_forced_steps=True)
+    observations, _ = env.reset(seed=list(seeds))
+    t99 = np.full(len(seeds), np.nan)
+    ended = np.zeros(len(seeds), dtype=bool)
+    decisions = 0
+    while not ended.all():
+        scores = observations["slots"].astype(np.float64) @ weights
+        scores = np.where(observations["action_mask"] > 0, scores, -np.inf)
+        observations, _, terminated, truncated, info = env.step(scores.argmax(axis=1))
+        decisions += int((~ended).sum())
+        new = (terminated | truncated) & ~ended
+        reached = new & (info["end_reason"] == "threshold")
+        t99[reached] = info["travelled"][reached]
+        ended |= new
+    env.close()
+    return t99, decisions
+
+
+def relative_t99(t99: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Per-episode T99 relative to the reference's (:data:`FAILURE` where either missed)."""
+    both = ~np.isnan(t99) & ~np.isnan(reference)
+    return np.where(both, t99 / np.where(both, reference, 1.0) - 1.0, FAILURE)
+
+
+def candidate_score(
+    configs: list[EnvConfig],
+    seeds: list[list[int]],
+    reference: list[np.ndarray],
+    weights: np.ndarray,
+) -> tuple[float, int]:
+    """The mean over families (each weighing alike) of the mean relative T99 of ``weights``
+    against ``reference`` on each family's ``seeds``; also the decisions played."""
+    differences, played = [], 0
+    for cfg, family_seeds, base in zip(configs, seeds, reference, strict=True):
+        t99, decisions = play_t99(cfg, family_seeds, weights)
+        differences.append(relative_t99(t99, base).mean())
+        played += decisions
+    return float(np.mean(differences)), played
+
+
+def linear_model(cfg: EnvConfig, weights: np.ndarray, device: str = "cpu") -> Any:
+    """A ``MaskedDQN`` whose linear slot scorer holds ``weights`` (for saving and validation)."""
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
+
+    env = make_batched_vec_env({"config": cfg}, 1)
+    model = MaskedDQN(
+        SlotDQNPolicy,
+        env,
+        buffer_size=1,
+        learning_starts=0,
+        device=device,
+        policy_kwargs={"scorer": "linear"},
+    )
+    set_weights(model, weights)
+    env.close()
+    return model
+
+
+def set_weights(model: Any, weights: np.ndarray) -> None:
+    import torch
+
+    value = torch.as_tensor(weights, dtype=torch.float32)
+    with torch.no_grad():
+        for network in (model.policy.q_net, model.policy.q_net_target):
+            network.q_net.weight.copy_(value)
+
+
+def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) -> TrainResult:
+    """Run CEM for ``experiment`` into ``run_dir`` (summary in ``RUN/cem.json``, one record
+    per generation in ``RUN/cem.jsonl``)."""
+    from frontier_marl.evaluation.families import family
+    from frontier_marl.progress import progress_bar as make_bar
+    from frontier_marl.training.family_validation import FamilyValidator
+    from frontier_marl.training.metadata import build_metadata, save_metadata
+    from frontier_marl.training.plots import plot_family_validation
+    from frontier_marl.training.train import TrainResult
+    from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
+
+    settings, cem = experiment.train, CEMSettings(**experiment.cem)
+    configs = experiment.env_configs()
+    cfg = configs[0]
+    names = feature_names(cfg)
+    mean = initial_weights(cem, names)
+    sigma = np.full(len(names), float(cem.sigma))
+    fixed = names.index("path")
+    sigma[fixed] = 0.0
+    reference_weights = np.zeros(len(names))
+    reference_weights[fixed] = mean[fixed]
+    rng = np.random.default_rng(settings.seed)
+    ranges = [family(name).train for name in settings.families]
+    model = linear_model(cfg, mean, settings.device)
+    model.num_timesteps = 0
+
+    def metadata() -> dict[str, Any]:
+        return build_metadata(
+            cfg,
+            model.observation_space,
+            model.action_space,
+            policy="SlotPolicy",
+            num_timesteps=model.num_timesteps,
+            experiment=experiment.to_dict(),
+            extra={"seed": settings.seed, "trained_by": "cem", "weights": weights_by_name()},
+        )
+
+    def weights_by_name() -> dict[str, float]:
+        current = model.policy.q_net.q_net.weight.detach().cpu().numpy()
+        return {name: float(w) for name, w in zip(names, current, strict=True)}
+
+    run_dir.mkdir(parents=True, exist_ok=True)
+    validator = FamilyValidator(settings.families, settings.validation_episodes, cfg)
+    keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, 0, validator)
+    log = run_dir / LOG_FILE
+    log.write_text("")
+    started, cpu_started = time.perf_counter(), time.process_time()
+    bar = make_bar(cem.generations, disable=not progress_bar, desc="cem", unit="gen")
+    for generation in range(cem.generations):
+        seeds = [[int(s) for s in rng.choice(r, cem.episodes, replace=False)] for r in ranges]
+        reference = [
+            play_t99(c, s, reference_weights)[0] for c, s in zip(configs, seeds, strict=True)
+        ]
+        candidates = [mean] + [
+            mean + sigma * rng.standard_normal(len(names)) for _ in range(cem.population - 1)
+        ]
+        scores = []
+        for weights in candidates:
+            score, decisions = candidate_score(configs, seeds, reference, weights)
+            scores.append(score)
+            model.num_timesteps += decisions
+        elite = np.array([candidates[i] for i in np.argsort(scores)[: cem.elite]])
+        mean = elite.mean(axis=0)
+        sigma = np.maximum(elite.std(axis=0), cem.min_sigma)
+        sigma[fixed] = 0.0
+        set_weights(model, mean)
+        score = keeper(model)
+        record = {
+            "generation": generation,
+            "decisions": model.num_timesteps,
+            "mean_vs_path_scorer": scores[0],
+            "best_vs_path_scorer": min(scores),
+            "validation_vs_nearest_path": -score,
+            "weights": weights_by_name(),
+            "wall_s": time.perf_counter() - started,
+        }
+        with log.open("a") as handle:
+            handle.write(json.dumps(record) + "\n")
+        bar.update(1)
+        bar.set_postfix(validation=f"{-score:+.1%}")
+    bar.close()
+    wall = time.perf_counter() - started
+    model.save(run_dir / "model.zip")
+    meta = metadata()
+    meta["training"] = {"wall_time_s": wall, "generations": cem.generations}
+    save_metadata(meta, run_dir / "model.json")
+    summary = {
+        "run_dir": str(run_dir),
+        "generations": cem.generations,
+        "decisions": model.num_timesteps,
+        "wall_time_s": wall,
+        "best_validation": None if math.isinf(keeper.best_score) else -keeper.best_score,
+        "weights": weights_by_name(),
+    }
+    (run_dir / "cem.json").write_text(json.dumps(summary, indent=2) + "\n")
+    plot_family_validation(
+        read_validation_log(run_dir),
+        run_dir / "validation_t99.png",
+        title=f"{experiment.name} (seed {settings.seed}, {cem.generations} generations)",
+        xlabel="decisions played in training (CEM)",
+    )
+    model_path = run_dir / "model.zip"
+    return TrainResult(
+        run_dir=run_dir,
+        model_path=model_path,
+        num_timesteps=model.num_timesteps,
+        steps_this_session=model.num_timesteps,
+        wall_time_s=wall,
+        cpu_time_s=time.process_time() - cpu_started,
+        interrupted=False,
+        files={"model": model_path, "metadata": run_dir / "model.json", "log": log},
+    )

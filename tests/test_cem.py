@@ -1,0 +1,146 @@
+"""The cross-entropy method on a linear slot scorer: its settings, its batched rollouts (the
+same episodes as the single env), the linear scorer, and `frontier-marl train` end to end."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from frontier_marl import FrontierParallelEnv
+from frontier_marl.cli import main
+from frontier_marl.training.cem import (
+    CEMSettings,
+    feature_names,
+    linear_model,
+    play_t99,
+    relative_t99,
+)
+from frontier_marl.training.experiment import load_experiment
+
+CEM_OVERRIDES = [
+    "train.algorithm=cem",
+    "train.families=['random-20', 'rooms-32']",
+    "env.tour=true",
+]
+
+
+def _config():  # noqa: ANN202
+    return load_experiment("explorer-dqn", CEM_OVERRIDES).env_configs()
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"elite": 5, "population": 4}, "must not exceed cem.population"),
+        ({"generations": 0}, "cem.generations"),
+        ({"sigma": 0}, "cem.sigma"),
+        ({"init": {"tour": -1.0}}, "'path'"),
+        ({"init": {"path": 1.0}}, "cem.init.path must be < 0"),
+    ],
+)
+def test_bad_cem_settings_are_refused_by_name(settings: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        CEMSettings(**settings)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        (["cem.populaton=3"], "unknown \\[cem\\] key"),
+        (["cem.init={path=-1.0, bogus=1.0}"], "unknown feature"),
+        (["train.families=[]"], "needs train.families and one robot"),
+    ],
+)
+def test_bad_cem_experiments_are_refused_by_name(overrides: list[str], message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        experiment = load_experiment("explorer-dqn", [*CEM_OVERRIDES, *overrides])
+        from frontier_marl.training.cem import initial_weights
+
+        initial_weights(CEMSettings(**experiment.cem), feature_names(experiment.env_config()))
+
+
+def _single_env_t99(cfg, seed: int, weights: np.ndarray) -> int | None:  # noqa: ANN001
+    """T99 of one episode on the ParallelEnv, the robot taking the best-scoring valid slot
+    at every step (forced steps included)."""
+    env = FrontierParallelEnv(config=cfg, info="minimal")
+    observations, _ = env.reset(seed=seed)
+    while True:
+        obs = observations["robot_0"]
+        scores = np.where(
+            obs["action_mask"] > 0, obs["slots"].astype(np.float64) @ weights, -np.inf
+        )
+        observations, _, terminated, truncated, infos = env.step({"robot_0": int(scores.argmax())})
+        if terminated["robot_0"] or truncated["robot_0"]:
+            info = infos["robot_0"]
+            return int(info["travelled"]) if info["end_reason"] == "threshold" else None
+
+
+def test_batched_rollouts_play_the_single_env_episodes() -> None:
+    cfg = _config()[1]  # rooms-32
+    names = feature_names(cfg)
+    weights = np.zeros(len(names))
+    weights[names.index("path")], weights[names.index("tour")] = -1.0, -0.5
+    seeds = [3, 17, 29]
+    t99, decisions = play_t99(cfg, seeds, weights)
+    expected = [_single_env_t99(cfg, seed, weights) for seed in seeds]
+    assert [None if np.isnan(t) else int(t) for t in t99] == expected
+    assert decisions > 0
+
+
+def test_relative_t99_counts_a_missed_episode_as_a_failure() -> None:
+    t99 = np.array([90.0, np.nan, 120.0])
+    reference = np.array([100.0, 100.0, np.nan])
+    assert relative_t99(t99, reference).tolist() == pytest.approx([-0.1, 1.0, 1.0])
+
+
+def test_the_linear_model_scores_slots_by_their_features() -> None:
+    cfg = _config()[0]
+    weights = np.linspace(-1.0, 1.0, len(feature_names(cfg)))
+    model = linear_model(cfg, weights)
+    env = FrontierParallelEnv(config=cfg)
+    obs = env.reset(seed=5)[0]["robot_0"]
+    q_values = model.q_net(model.policy.obs_to_tensor(obs)[0])[0]
+    valid = obs["action_mask"] > 0
+    expected = torch.as_tensor(obs["slots"][valid] @ weights.astype(np.float32))
+    assert torch.allclose(q_values[torch.as_tensor(valid)], expected, atol=1e-5)
+    assert (q_values[torch.as_tensor(~valid)] <= -1e8).all()
+
+
+def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> None:
+    run_dir = tmp_path / "cem"
+    tiny = ["cem.generations=2", "cem.population=3", "cem.elite=2", "cem.episodes=1"]
+    tiny += ["train.validation_episodes=1"]
+    argv = ["train", "explorer", "--out", str(run_dir), "--no-progress"]
+    assert main([*argv, *(arg for s in tiny for arg in ("--set", s))]) == 0
+    records = [json.loads(line) for line in (run_dir / "cem.jsonl").read_text().splitlines()]
+    assert [r["generation"] for r in records] == [0, 1]
+    assert records[0]["weights"]["path"] == records[1]["weights"]["path"] == -1.0
+    assert (run_dir / "best" / "model.zip").is_file()
+    assert (run_dir / "validation_t99.png").is_file()
+    meta = json.loads((run_dir / "model.json").read_text())
+    assert meta["trained_by"] == "cem" and meta["weights"] == records[1]["weights"]
+    out = tmp_path / "bench.json"
+    argv = ["benchmark", "--families", "random-20", "--policies", f"nearest-path,{run_dir}"]
+    assert main([*argv, "--episodes", "1", "--split", "validation", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert rows[1]["success"] == 1.0
+
+
+def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: Path) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_ablation.py"
+    ablation = runpy.run_path(str(script))["main"]
+    out = tmp_path / "ablation.json"
+    argv = ["--episodes", "1", "--out", str(tmp_path / "models"), "--json", str(out)]
+    assert ablation([*argv, "--no-progress"]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    policies = {row["policy"] for row in rows}
+    assert policies == {"nearest-path", "path-only", "tour-rule", "explorer-dqn", "explorer"}
+    assert all(row["seeds"][0] == 800_000 for row in rows)
+    tour_rule = json.loads((tmp_path / "models" / "tour-rule" / "model.json").read_text())
+    assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
