@@ -300,3 +300,19 @@ def test_the_shipped_team_explorer_acts_for_teams_of_2_4_and_8(tmp_path) -> None
         rows = json.loads(out.read_text())["rows"]
         assert [row["agents"] for row in rows] == [agents, agents]
         assert all(row["success"] == 1 for row in rows)
+
+
+@pytest.mark.parametrize(
+    ("policy_kwargs", "message"),
+    [
+        ({"scorer": "tree"}, "scorer must be one of"),
+        ({"scorer": "linear", "attention_heads": 4}, "needs scorer='mlp'"),
+    ],
+)
+def test_bad_scorer_settings_are_refused(policy_kwargs: dict, message: str) -> None:
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
+
+    env = make_batched_vec_env({"config": make_config("thesis-20x20", **EXPLORER)}, 1)
+    with pytest.raises(ValueError, match=message):
+        MaskedDQN(SlotDQNPolicy, env, buffer_size=10, policy_kwargs=policy_kwargs)
