@@ -10,7 +10,8 @@ ones), with ``frontier-marl benchmark``:
 * ``explorer-dqn``: the DQN-trained slot scorer (no tour feature);
 * ``explorer``: the shipped CEM-trained linear scorer (with the tour feature);
 * any further model given with ``--models`` (e.g. a CEM run without the tour feature:
-  ``frontier-marl train explorer --set env.tour=false --out runs/explorer-no-tour``).
+  ``frontier-marl train explorer --set env.tour=false --out runs/no-tour``, then
+  ``cp -r runs/no-tour/best runs/explorer-no-tour``: a model is labelled by its folder).
 
     python benchmarks/explorer_ablation.py --episodes 64 \
         --json training/results/explorer/ablation.json
@@ -24,9 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from frontier_marl.cli import main as cli
-from frontier_marl.training.cem import feature_names, linear_model
+from frontier_marl.training.cem import feature_names, linear_metadata, linear_model
 from frontier_marl.training.experiment import load_experiment
-from frontier_marl.training.metadata import build_metadata, save_metadata
+from frontier_marl.training.metadata import save_metadata
 
 HAND_SET = {"path-only": {"path": -1.0}, "tour-rule": {"path": -1.0, "tour": -0.5}}
 
@@ -43,18 +44,7 @@ def save_hand_set(out: Path) -> list[str]:
         folder = out / label
         folder.mkdir(parents=True, exist_ok=True)
         model.save(folder / "model.zip")
-        meta = build_metadata(
-            cfg,
-            model.observation_space,
-            model.action_space,
-            policy="SlotPolicy",
-            num_timesteps=0,
-            experiment=experiment.to_dict(),
-            extra={
-                "trained_by": "hand-set",
-                "weights": dict(zip(names, vector.tolist(), strict=True)),
-            },
-        )
+        meta = linear_metadata(model, cfg, experiment, trained_by="hand-set")
         save_metadata(meta, folder / "model.json")
         folders.append(str(folder))
     return folders

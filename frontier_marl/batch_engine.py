@@ -137,15 +137,14 @@ class BatchMDP:
         self.oscillation = np.where(moved, oscillation, self.oscillation)
         self.new_cells, self.outcome = new_cells, outcome
 
-    def play_forced(self) -> int:
+    def play_forced(self) -> None:
         """Step every live world whose robots each have exactly one valid slot (a commitment,
         or a single cluster) with that slot, until every live world offers a choice or has
         ended. ``outcome`` then holds the rewards summed since the last decision and the ends
-        reached on the way. Returns the steps played (the most any world took)."""
+        reached on the way."""
         total = self.outcome
         rewards, reason = total.rewards.copy(), total.reason.copy()
         terminated, truncated = total.terminated.copy(), total.truncated.copy()
-        played = 0
         while True:
             forced = ~self.done & (self.slots.mask.sum(axis=2) == 1).all(axis=1)
             if not forced.any():
@@ -156,9 +155,7 @@ class BatchMDP:
             terminated |= step.terminated
             truncated |= step.truncated
             reason = np.where(step.reason != 0, step.reason, reason)
-            played += 1
         self.outcome = BatchOutcome(rewards, terminated, truncated, reason)
-        return played
 
     # ------------------------------------------------------------------ views
     def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:

@@ -33,13 +33,13 @@ import numpy as np
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.slot_features import EXPLORER_FEATURES, TEAM_FEATURES, TOUR_FEATURE
+from frontier_marl.training.family_validation import FAILURE
 
 if TYPE_CHECKING:
     from frontier_marl.training.experiment import Experiment
     from frontier_marl.training.train import TrainResult
 
 LOG_FILE = "cem.jsonl"
-FAILURE = 1.0  # the relative T99 of an episode that misses 99 %
 
 
 @dataclass(frozen=True)
@@ -173,6 +173,26 @@ def linear_model(cfg: EnvConfig, weights: np.ndarray, device: str = "cpu") -> An
     return model
 
 
+def linear_metadata(
+    model: Any, cfg: EnvConfig, experiment: Experiment, **extra: Any
+) -> dict[str, Any]:
+    """The ``model.json`` of a linear slot scorer: the usual metadata, its weights by feature
+    name, and ``extra`` (e.g. ``trained_by``)."""
+    from frontier_marl.training.metadata import build_metadata
+
+    current = model.policy.q_net.q_net.weight.detach().cpu().numpy()
+    weights = {name: float(w) for name, w in zip(feature_names(cfg), current, strict=True)}
+    return build_metadata(
+        cfg,
+        model.observation_space,
+        model.action_space,
+        policy="SlotPolicy",
+        num_timesteps=model.num_timesteps,
+        experiment=experiment.to_dict(),
+        extra={**extra, "weights": weights},
+    )
+
+
 def set_weights(model: Any, weights: np.ndarray) -> None:
     import torch
 
@@ -188,7 +208,7 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
     from frontier_marl.evaluation.families import family
     from frontier_marl.progress import progress_bar as make_bar
     from frontier_marl.training.family_validation import FamilyValidator
-    from frontier_marl.training.metadata import build_metadata, save_metadata
+    from frontier_marl.training.metadata import save_metadata
     from frontier_marl.training.plots import plot_family_validation
     from frontier_marl.training.train import TrainResult
     from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
@@ -209,19 +229,7 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
     model.num_timesteps = 0
 
     def metadata() -> dict[str, Any]:
-        return build_metadata(
-            cfg,
-            model.observation_space,
-            model.action_space,
-            policy="SlotPolicy",
-            num_timesteps=model.num_timesteps,
-            experiment=experiment.to_dict(),
-            extra={"seed": settings.seed, "trained_by": "cem", "weights": weights_by_name()},
-        )
-
-    def weights_by_name() -> dict[str, float]:
-        current = model.policy.q_net.q_net.weight.detach().cpu().numpy()
-        return {name: float(w) for name, w in zip(names, current, strict=True)}
+        return linear_metadata(model, cfg, experiment, seed=settings.seed, trained_by="cem")
 
     run_dir.mkdir(parents=True, exist_ok=True)
     validator = FamilyValidator(settings.families, settings.validation_episodes, cfg)
@@ -255,7 +263,7 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
             "mean_vs_path_scorer": scores[0],
             "best_vs_path_scorer": min(scores),
             "validation_vs_nearest_path": -score,
-            "weights": weights_by_name(),
+            "weights": metadata()["weights"],
             "wall_s": time.perf_counter() - started,
         }
         with log.open("a") as handle:
@@ -274,7 +282,7 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
         "decisions": model.num_timesteps,
         "wall_time_s": wall,
         "best_validation": None if math.isinf(keeper.best_score) else -keeper.best_score,
-        "weights": weights_by_name(),
+        "weights": meta["weights"],
     }
     (run_dir / "cem.json").write_text(json.dumps(summary, indent=2) + "\n")
     plot_family_validation(

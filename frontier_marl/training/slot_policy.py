@@ -50,6 +50,12 @@ class SlotExtractor(BaseFeaturesExtractor):
         return th.cat([slots, observations["action_mask"].float()], dim=1)
 
 
+def split_slots(flat: th.Tensor, n_slots: int, n_features: int) -> tuple[th.Tensor, th.Tensor]:
+    """``(B, S * F + S)`` (features, then mask) -> features ``(B, S, F)`` and mask ``(B, S)``."""
+    slots = flat[:, : n_slots * n_features].reshape(-1, n_slots, n_features)
+    return slots, flat[:, n_slots * n_features :] > 0.5
+
+
 class SlotScorer(nn.Module):
     """Q-values of S slots from ``(B, S * F + S)`` (features, then mask): a shared encoder
     per slot, optionally one layer of self-attention among the live slots (``attention_heads``
@@ -85,9 +91,8 @@ class SlotScorer(nn.Module):
         self.value = nn.Sequential(_mlp([2 * width, width], activation), nn.Linear(width, 1))
 
     def forward(self, flat: th.Tensor) -> th.Tensor:
-        batch, s, f = flat.shape[0], self.n_slots, self.n_features
-        slots = flat[:, : s * f].reshape(batch, s, f)
-        mask = flat[:, s * f :] > 0.5
+        s = self.n_slots
+        slots, mask = split_slots(flat, s, self.n_features)
         encoded = self.encode(slots)  # (B, S, H)
         if self.attend is not None:
             # rows without a live slot (never chosen from) attend to every slot, not to none
@@ -121,9 +126,7 @@ class LinearSlotScorer(nn.Module):
         self.weight = nn.Parameter(th.zeros(n_features))
 
     def forward(self, flat: th.Tensor) -> th.Tensor:
-        s, f = self.n_slots, self.n_features
-        slots = flat[:, : s * f].reshape(-1, s, f)
-        mask = flat[:, s * f :] > 0.5
+        slots, mask = split_slots(flat, self.n_slots, self.n_features)
         return (slots @ self.weight).masked_fill(~mask, MASKED_Q)
 
 
