@@ -18,6 +18,7 @@ from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.episodes import EpisodeSource, world_params
+from frontier_marl.motion import MotionTrail
 from frontier_marl.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.rewards import BatchOutcome, OscillationHistory, batch_outcome
 
@@ -46,6 +47,7 @@ class BatchMDP:
         self.rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(n)]
         self.slots = SlotArrays.empty(n, k, cfg.n_slots)
         self._oscillation = OscillationHistory(n, k, cfg.reward.oscillation_window)
+        self._trail = MotionTrail(n, k) if cfg.observation.turn else None
         self.steps = np.zeros(n, dtype=np.int64)
         self.steps_without_progress = np.zeros(n, dtype=np.int64)
         self.done = np.ones(n, dtype=bool)
@@ -66,6 +68,8 @@ class BatchMDP:
             true_grid, starts, start_region = self.source.draw(self.rngs[i])
             self.worlds.place(i, true_grid, starts, start_region)
         self._oscillation.clear(worlds)
+        if self._trail is not None:
+            self._trail.clear(worlds, self.worlds.positions[worlds])
         self.steps[worlds] = 0
         self.steps_without_progress[worlds] = 0
         self.done[worlds] = False
@@ -92,6 +96,8 @@ class BatchMDP:
         oscillation = self._oscillation.update(targets, active)
         worlds = self.worlds
         before = worlds.travelled.copy()
+        if self._trail is not None:
+            self._trail.push(worlds.positions, active)
         worlds.move(targets, active)
         new_cells = np.where(active[:, None], worlds.new_cells, 0)
         self.steps += active
@@ -164,11 +170,13 @@ class BatchMDP:
         shape = positions.shape[:2]
         count = shape[0] * shape[1]
         mates = self._teammates(worlds)
+        motion = None if self._trail is None else self._trail.motion(worlds, positions)
         batch = self.encoder.encode_batch(
             self.slots.rows(worlds),
             positions.reshape(count, 2),
             None if mates is None else mates.reshape(count, -1),
             self.heading[worlds].reshape(count, 2),
+            None if motion is None else motion.reshape(count, 2),
         )
         if isinstance(batch, dict):
             return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}

@@ -62,6 +62,9 @@ class ObservationConfig:
         tour: with ``features="explorer"``, one more feature per slot: the length of the
             nearest-neighbour tour from the slot's target through every other live slot's
             target (:func:`frontier_marl.slot_features.tour_lengths`).
+        turn: with ``features="explorer"``, one more feature per slot: how far the slot's
+            target turns the robot away from its motion over its last steps
+            (:func:`frontier_marl.slot_features.turn_costs`).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -74,6 +77,7 @@ class ObservationConfig:
     features: FeatureLayout = "thesis"
     commit: CommitRule = "none"
     tour: bool = False
+    turn: bool = False
 
     def validate(self) -> None:
         check_choice("features", self.features, get_args(FeatureLayout))
@@ -87,10 +91,14 @@ class ObservationConfig:
             "action_mask",
             "normalize",
             "tour",
+            "turn",
         ):
             check_bool(name, getattr(self, name))
-        if self.tour and self.features != "explorer":
-            raise ValueError("tour=True needs features='explorer' (it is a per-slot feature)")
+        for name in ("tour", "turn"):
+            if getattr(self, name) and self.features != "explorer":
+                raise ValueError(
+                    f"{name}=True needs features='explorer' (it is a per-slot feature)"
+                )
         if self.centroid == "none" and not self.info_gain:
             raise ValueError(
                 "observation is empty: centroid='none' needs info_gain=True "

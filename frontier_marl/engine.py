@@ -20,6 +20,7 @@ from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
 from frontier_marl.episodes import EpisodeSource, world_params
+from frontier_marl.motion import MotionTrail
 from frontier_marl.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
 
@@ -67,6 +68,7 @@ class ExplorationMDP:
         self._slot_arrays: SlotArrays | None = None
         self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
+        self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
         self.last: StepResult | None = None  # the latest step, None right after reset
         self.steps = 0
         self.steps_without_progress = 0
@@ -78,6 +80,8 @@ class ExplorationMDP:
         true_grid, starts, start_region = self.source.draw(rng)
         self.world = World(true_grid, starts, self.params, start_region)
         self._oscillation.clear(slice(None))
+        if self._trail is not None:
+            self._trail.clear(slice(None), self.world.positions[None])
         self.steps = 0
         self.steps_without_progress = 0
         self.done = False
@@ -107,6 +111,8 @@ class ExplorationMDP:
         oscillation = self._oscillation.update(targets[None])[0]
         world = self.world
         before = world.travelled.copy()
+        if self._trail is not None:
+            self._trail.push(world.positions[None], np.ones(1, dtype=bool))
         moved = world.move(targets)
         self.steps += 1
         new_cells = moved.new_cells
@@ -200,11 +206,13 @@ class ExplorationMDP:
         positions = self.world.positions
         heading = self._heading(targets, reached)
         mates = self._teammate_table(positions, heading)
+        motion = None if self._trail is None else self._trail.motion(0, positions)
         batch = self.encoder.encode_batch(
             self._slot_arrays,
             positions,
             None if mates is None else teammate_rows(mates),
             heading,
+            motion,
         )
         if isinstance(batch, dict):
             agents = range(self.cfg.n_agents)

@@ -34,6 +34,7 @@ from frontier_marl.slot_features import (
     explorer_space,
     team_features,
     tour_lengths,
+    turn_costs,
 )
 
 
@@ -54,8 +55,9 @@ class ObservationEncoder:
         self.features = obs.features
         if self.features == "explorer":
             team = len(TEAM_FEATURES) if self.teammates != "none" else 0
-            self.tour = obs.tour
-            self.features_per_slot = len(EXPLORER_FEATURES) + int(self.tour) + team
+            self.tour, self.turn = obs.tour, obs.turn
+            extra = int(self.tour) + int(self.turn)
+            self.features_per_slot = len(EXPLORER_FEATURES) + extra + team
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
         height, width = cfg.height, cfg.width
@@ -110,18 +112,22 @@ class ObservationEncoder:
         position: np.ndarray,
         teammates: np.ndarray | None = None,
         heading: np.ndarray | None = None,
+        motion: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
         """The observation of a robot at ``position`` with slot table ``slots``.
 
         ``teammates`` is (N-1, 2) or (N-1, 4): the other robots' (row, col) positions, and
         targets for ``positions+targets``; needed only when the layout includes teammates.
         ``heading``: the cell the robot is heading to (row -1: none), for the explorer layout.
+        ``motion``: its displacement over its last steps (:mod:`frontier_marl.motion`), for
+        the ``turn`` feature (default: none).
         """
         batch = self.encode_batch(
             SlotArrays.stack([slots]),
             np.asarray(position)[None],
             None if teammates is None else np.asarray(teammates).reshape(1, -1),
             None if heading is None else np.asarray(heading).reshape(1, 2),
+            None if motion is None else np.asarray(motion).reshape(1, 2),
         )
         if isinstance(batch, dict):
             return {key: value[0] for key, value in batch.items()}
@@ -133,10 +139,12 @@ class ObservationEncoder:
         positions: np.ndarray,
         teammates: np.ndarray | None = None,
         heading: np.ndarray | None = None,
+        motion: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
         """The observations of M robots at once: ``slots`` with ``(M, n_slots, ...)`` fields,
         ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened per robot,
-        ``heading`` (M, 2) the cells they head to (row -1: none; default none). Returns the
+        ``heading`` (M, 2) the cells they head to (row -1: none; default none), ``motion``
+        (M, 2) their displacements over their last steps (default: none). Returns the
         ``(M, ...)`` array, or a dict of them, in :attr:`space`'s layout."""
         if self.features == "explorer":
             if heading is None:
@@ -144,6 +152,11 @@ class ObservationEncoder:
             features = explorer_features(slots, positions, heading)
             if self.tour:
                 features = np.concatenate([features, tour_lengths(slots)], axis=-1)
+            if self.turn:
+                if motion is None:
+                    motion = np.zeros_like(positions)
+                turn = turn_costs(slots, positions, motion)
+                features = np.concatenate([features, turn], axis=-1)
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
@@ -215,6 +228,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "sort_by_distance": cfg.observation.sort_by_distance,
             "teammates": cfg.observation.teammates,
             "tour": cfg.observation.tour,
+            "turn": cfg.observation.turn,
             "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,

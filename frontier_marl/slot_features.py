@@ -21,6 +21,13 @@ With ``tour=True``, one more (:data:`TOUR_FEATURE`), after those:
                 and visits every other live slot's target (:func:`tour_lengths`): how well
                 going there first fits a route through all the nearby frontiers
 
+With ``turn=True``, one more (:data:`TURN_FEATURE`), after those:
+
+``turn``        1 - cos of the angle between the robot's motion over its last
+                :data:`~frontier_marl.motion.TRAIL_STEPS` steps and the direction to the
+                slot's target (:func:`turn_costs`): 0 straight ahead, 2 straight back; 0
+                when the robot has not moved in those steps or stands on the target
+
 With teammates observed (``teammates`` other than ``none``), three more per slot
 (:data:`TEAM_FEATURES`), whatever the team's size:
 
@@ -43,6 +50,7 @@ EXPLORER_FEATURES = (
     "live",
 )  # fmt: skip
 TOUR_FEATURE = "tour"
+TURN_FEATURE = "turn"
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
 _BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
@@ -116,6 +124,19 @@ def tour_lengths(slots: SlotArrays) -> np.ndarray:
         visited |= going[..., None] & (np.arange(n_slots)[None, None, :] == nearest[..., None])
     length[~valid] = 0.0
     return (length / CELLS).astype(np.float32)[..., None]
+
+
+def turn_costs(slots: SlotArrays, positions: np.ndarray, motion: np.ndarray) -> np.ndarray:
+    """(M, n_slots, 1) :data:`TURN_FEATURE` of M robots at ``positions`` (M, 2) that moved by
+    ``motion`` (M, 2) cells over their last steps (0 on padding slots)."""
+    ahead = slots.target - positions[:, None, :]  # (M, S, 2)
+    to_target = np.linalg.norm(ahead, axis=-1)
+    moved = np.linalg.norm(motion, axis=-1)[:, None]  # (M, 1)
+    dot = (ahead * motion[:, None, :]).sum(axis=-1)
+    scale = to_target * moved
+    cosine = np.divide(dot, scale, out=np.ones_like(scale, dtype=np.float64), where=scale > 0)
+    turn = np.where(slots.valid, 1.0 - cosine, 0.0)
+    return turn.astype(np.float32)[..., None]
 
 
 def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:

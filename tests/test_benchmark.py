@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -270,11 +271,21 @@ def test_cli_team_adds_makespan_and_overlap(tmp_path, capsys):
         (["--set", "n_agents=3"], "n_agents"),
         (["--set", "perception_range=0"], "perception_range"),
         (["--families", ","], "at least one family"),
+        (["--policies", "nearest-path,nearest-path"], "share the label 'nearest-path'"),
     ],
 )
 def test_cli_bad_input(argv, message, capsys):
     assert main(["benchmark", "--no-progress", *argv]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_models_in_folders_of_one_name_are_refused(tmp_path):
+    shipped = Path(frontier_marl.__file__).parent / "assets" / "models" / "explorer"
+    folders = [tmp_path / run / "best" for run in ("run-a", "run-b")]
+    for folder in folders:
+        shutil.copytree(shipped, folder)
+    with pytest.raises(ValueError, match="share the label 'best'"):
+        bench.contenders([str(folder) for folder in folders])
 
 
 @pytest.mark.parametrize("agents", ["0", "-1"])

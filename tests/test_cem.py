@@ -25,6 +25,7 @@ CEM_OVERRIDES = [
     "train.algorithm=cem",
     "train.families=['random-20', 'rooms-32']",
     "env.tour=true",
+    "env.turn=true",
 ]
 
 
@@ -84,6 +85,7 @@ def test_batched_rollouts_play_the_single_env_episodes() -> None:
     names = feature_names(cfg)
     weights = np.zeros(len(names))
     weights[names.index("path")], weights[names.index("tour")] = -1.0, -0.5
+    weights[names.index("turn")] = -0.05
     seeds = [3, 17, 29]
     t99, decisions = play_t99(cfg, seeds, weights)
     expected = [_single_env_t99(cfg, seed, weights) for seed in seeds]
@@ -144,3 +146,17 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
     assert all(row["seeds"][0] == 800_000 for row in rows)
     tour_rule = json.loads((tmp_path / "models" / "tour-rule" / "model.json").read_text())
     assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
+
+
+def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_path: Path) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_selection.py"
+    selection = runpy.run_path(str(script))["main"]
+    out = tmp_path / "selection.json"
+    assert selection(["--episodes", "1", "--json", str(out), "--no-progress"]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert {row["policy"] for row in rows} == {"nearest-path", "explorer"}
+    assert all(row["seeds"] == [800_100] for row in rows)
+    with pytest.raises(SystemExit):
+        selection(["--first", "900000"])  # a held-out seed

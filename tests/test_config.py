@@ -70,6 +70,7 @@ BAD_VALUES = [
     ("action_mask", 0, "action_mask"),
     ("normalize", "false", "normalize"),
     ("tour", 1, "tour"),
+    ("turn", 1, "turn"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),
     ("explore_threshold", 1.01, "explore_threshold"),

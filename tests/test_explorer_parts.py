@@ -10,8 +10,15 @@ import torch
 import frontier_marl
 from frontier_marl.config import make_config
 from frontier_marl.core.slots import SlotArrays, SlotTable
+from frontier_marl.motion import TRAIL_STEPS, MotionTrail
 from frontier_marl.rewards import StepEvents, step_outcome
-from frontier_marl.slot_features import CELLS, EXPLORER_FEATURES, explorer_features, tour_lengths
+from frontier_marl.slot_features import (
+    CELLS,
+    EXPLORER_FEATURES,
+    explorer_features,
+    tour_lengths,
+    turn_costs,
+)
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown"}
 
@@ -66,6 +73,52 @@ def test_the_tour_feature_extends_the_explorer_layout_and_needs_it() -> None:
     assert np.array_equal(slots[:, :-1], without)
     with pytest.raises(ValueError, match="tour=True needs features='explorer'"):
         make_config("thesis-20x20", tour=True)
+
+
+def test_turn_costs_on_a_hand_made_table() -> None:
+    table = _table([(5, 9), (5, 1), (9, 5), (5, 5)], [4, 4, 4, 0], n_slots=5)
+    slots = SlotArrays.stack([table, table])
+    positions = np.array([[5, 5], [5, 5]])
+    motion = np.array([[0, 3], [0, 0]])  # moving right; standing still
+    turns = turn_costs(slots, positions, motion)
+    assert turns.shape == (2, 5, 1)
+    # ahead, behind, to the side, on the robot's cell, padding
+    assert turns[0, :, 0].tolist() == pytest.approx([0.0, 2.0, 1.0, 0.0, 0.0])
+    assert not turns[1].any()  # no motion, no turn
+
+
+def test_the_motion_trail_spans_the_last_steps_of_active_worlds() -> None:
+    trail = MotionTrail(2, 1)
+    trail.clear(slice(None), np.array([[[0, 0]], [[4, 4]]]))
+    path = [(0, 1), (0, 2), (1, 2), (2, 2), (3, 2)]
+    position = np.array([[[0, 0]], [[4, 4]]])
+    moved = []
+    for cell in path:
+        trail.push(position, np.array([True, False]))
+        position = np.array([[cell], [[4, 4]]])
+        moved.append(trail.motion(slice(None), position)[:, 0].tolist())
+    # world 0 moves by the cells of its last TRAIL_STEPS (3) steps; world 1 is never pushed
+    assert [m[0] for m in moved] == [[0, 1], [0, 2], [1, 2], [2, 1], [3, 0]]
+    assert all(m[1] == [0, 0] for m in moved)
+    assert TRAIL_STEPS == 3
+
+
+def test_the_turn_feature_follows_the_robots_own_steps() -> None:
+    env = frontier_marl.parallel_env(**EXPLORER, tour=True, turn=True)
+    observations, _ = env.reset(seed=4)
+    cells = [env.world.positions[0].copy()]
+    for _ in range(12):
+        obs = observations["robot_0"]
+        assert obs["slots"].shape == (6, len(EXPLORER_FEATURES) + 2)
+        oldest = cells[max(len(cells) - 1 - TRAIL_STEPS, 0)]
+        here = env.world.positions[0]
+        table = env.mdp.slot_tables()[0]
+        expected = turn_costs(SlotArrays.stack([table]), here[None], (here - oldest)[None])
+        assert np.array_equal(obs["slots"][:, -1], expected[0, :, 0])
+        observations, *_ = env.step({"robot_0": int(np.flatnonzero(obs["action_mask"])[-1])})
+        cells.append(env.world.positions[0].copy())
+    with pytest.raises(ValueError, match="turn=True needs features='explorer'"):
+        make_config("thesis-20x20", turn=True)
 
 
 def test_team_features_on_a_hand_made_table() -> None:

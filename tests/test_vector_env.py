@@ -121,6 +121,7 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         {"cells_per_step": "full", "map_mode": "dynamic", "start_cells": "any-free"},
         {"features": "explorer", "commit": "until-progress", "reward": "travel", "max_steps": 40},
         {"features": "explorer", "n_agents": 3, "teammates": "positions+targets", "max_steps": 40},
+        {"features": "explorer", "n_agents": 2, "tour": True, "turn": True, "max_steps": 40},
     ],
     ids=[
         "relative-sorted-r1",
@@ -130,6 +131,7 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         "full",
         "explorer-commit",
         "explorer-team",
+        "explorer-tour-turn",
     ],  # fmt: skip
 )
 def test_equality_holds_for_every_observation_and_reward_variant(kwargs: dict[str, Any]) -> None:

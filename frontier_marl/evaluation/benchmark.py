@@ -122,6 +122,13 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
                 f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), {ORACLE}, "
                 f"a shipped model ({', '.join(PRETRAINED)}), nor a model file or run folder"
             )
+    labels = [contender.name for contender in out]
+    repeated = sorted({label for label in labels if labels.count(label) > 1})
+    if repeated:
+        raise ValueError(
+            f"two policies share the label {', '.join(map(repr, repeated))} (a model is "
+            "labelled by its folder): copy one to a folder of another name"
+        )
     return out
 
 

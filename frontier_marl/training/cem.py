@@ -32,7 +32,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.slot_features import EXPLORER_FEATURES, TEAM_FEATURES, TOUR_FEATURE
+from frontier_marl.slot_features import (
+    EXPLORER_FEATURES,
+    TEAM_FEATURES,
+    TOUR_FEATURE,
+    TURN_FEATURE,
+)
 from frontier_marl.training.family_validation import FAILURE
 
 if TYPE_CHECKING:
@@ -97,6 +102,7 @@ def feature_names(cfg: EnvConfig) -> list[str]:
     if obs.features != "explorer":
         raise ValueError("the linear slot scorer needs features = 'explorer'")
     names = list(EXPLORER_FEATURES) + ([TOUR_FEATURE] if obs.tour else [])
+    names += [TURN_FEATURE] if obs.turn else []
     return names + (list(TEAM_FEATURES) if obs.teammates != "none" else [])
 
 
