@@ -22,32 +22,19 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 from frontier_marl.cli import main as cli
-from frontier_marl.training.cem import feature_names, linear_metadata, linear_model
+from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
-from frontier_marl.training.metadata import save_metadata
 
 HAND_SET = {"path-only": {"path": -1.0}, "tour-rule": {"path": -1.0, "tour": -0.5}}
 
 
-def save_hand_set(out: Path) -> list[str]:
+def save_rules(out: Path) -> list[str]:
     """Save the hand-set linear scorers under ``out``; returns their folders."""
     experiment = load_experiment("explorer")
-    cfg = experiment.env_config()
-    names = feature_names(cfg)
-    folders = []
     for label, weights in HAND_SET.items():
-        vector = np.array([weights.get(name, 0.0) for name in names])
-        model = linear_model(cfg, vector)
-        folder = out / label
-        folder.mkdir(parents=True, exist_ok=True)
-        model.save(folder / "model.zip")
-        meta = linear_metadata(model, cfg, experiment, trained_by="hand-set")
-        save_metadata(meta, folder / "model.json")
-        folders.append(str(folder))
-    return folders
+        save_hand_set(weights, out / label, experiment)
+    return [str(out / label) for label in HAND_SET]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -58,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    policies = ["nearest-path", *save_hand_set(args.out), "explorer-dqn", "explorer"]
+    policies = ["nearest-path", *save_rules(args.out), "explorer-dqn", "explorer"]
     policies += [m for m in args.models.split(",") if m]
     command = ["benchmark", "--split", "validation", "--episodes", str(args.episodes)]
     command += ["--policies", ",".join(policies)]

@@ -18,6 +18,7 @@ from frontier_marl.training.cem import (
     linear_model,
     play_t99,
     relative_t99,
+    save_hand_set,
 )
 from frontier_marl.training.experiment import load_experiment
 
@@ -160,3 +161,26 @@ def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_pat
     assert all(row["seeds"] == [800_100] for row in rows)
     with pytest.raises(SystemExit):
         selection(["--first", "900000"])  # a held-out seed
+
+
+def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_tour_sweep.py"
+    sweep = runpy.run_path(str(script))["main"]
+    out = tmp_path / "sweep.json"
+    argv = ["--weights=-0.5,-1", "--episodes", "1", "--out", str(tmp_path / "m")]
+    assert sweep([*argv, "--json", str(out), "--no-progress"]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert {row["policy"] for row in rows} == {"nearest-path", "tour-0.5", "tour-1"}
+    assert all(row["seeds"] == [700_000] for row in rows)
+    rule = json.loads((tmp_path / "m" / "tour-1" / "model.json").read_text())
+    assert rule["weights"]["tour"] == -1.0 and rule["trained_by"] == "hand-set"
+    for bad in (["--first", "800000"], ["--weights", "a,b"]):
+        with pytest.raises(SystemExit):
+            sweep(bad)
+
+
+def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="unknown feature"):
+        save_hand_set({"path": -1.0, "tuor": -0.5}, tmp_path, load_experiment("explorer"))

@@ -199,6 +199,24 @@ def linear_metadata(
     )
 
 
+def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experiment) -> None:
+    """Save a linear slot scorer with hand-set ``weights`` (by feature name, the others 0) on
+    ``experiment``'s observation as a model folder (``model.zip`` and ``model.json``)."""
+    from frontier_marl.training.metadata import save_metadata
+
+    cfg = experiment.env_config()
+    names = feature_names(cfg)
+    unknown = set(weights) - set(names)
+    if unknown:
+        raise ValueError(f"unknown feature(s) {sorted(unknown)}; features: {names}")
+    model = linear_model(cfg, np.array([float(weights.get(name, 0.0)) for name in names]))
+    folder.mkdir(parents=True, exist_ok=True)
+    model.save(folder / "model.zip")
+    save_metadata(
+        linear_metadata(model, cfg, experiment, trained_by="hand-set"), folder / "model.json"
+    )
+
+
 def set_weights(model: Any, weights: np.ndarray) -> None:
     import torch
 
