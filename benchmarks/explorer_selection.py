@@ -16,13 +16,12 @@ Held-out seeds (900,000 and up) are never touched.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 from pathlib import Path
 
-from frontier_marl.evaluation.benchmark import contenders, run_benchmark
+from frontier_marl.evaluation.benchmark import run_on_seeds
 from frontier_marl.evaluation.benchmark_stats import format_table
-from frontier_marl.evaluation.families import FAMILIES, VALIDATION_SEEDS
+from frontier_marl.evaluation.families import VALIDATION_SEEDS
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -35,13 +34,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not VALIDATION_SEEDS.start <= args.first < VALIDATION_SEEDS.stop:
         parser.error(f"--first must be a validation seed, in {VALIDATION_SEEDS}")
-    seeds = range(args.first, VALIDATION_SEEDS.stop)
-    families = [dataclasses.replace(f, validation=seeds) for f in FAMILIES.values()]
     names = ["nearest-path", "explorer", *[m for m in args.models.split(",") if m]]
-    rows = run_benchmark(
-        families, contenders(names), args.episodes, progress=not args.no_progress,
-        split="validation",
-    )  # fmt: skip
+    seeds = range(args.first, VALIDATION_SEEDS.stop)
+    rows = run_on_seeds(names, seeds, args.episodes, progress=not args.no_progress)
     print(format_table(rows))
     means: dict[str, list[float]] = {}
     for row in rows:

@@ -12,13 +12,12 @@ features has no better weight to find for any family::
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 from pathlib import Path
 
-from frontier_marl.evaluation.benchmark import contenders, run_benchmark
+from frontier_marl.evaluation.benchmark import run_on_seeds
 from frontier_marl.evaluation.benchmark_stats import format_table
-from frontier_marl.evaluation.families import FAMILIES, TRAIN_SEEDS
+from frontier_marl.evaluation.families import TRAIN_SEEDS
 from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
 
@@ -44,13 +43,8 @@ def main(argv: list[str] | None = None) -> int:
         folder = args.out / f"tour{weight:+g}"
         save_hand_set({"path": -1.0, "tour": weight}, folder, experiment)
         folders.append(str(folder))
-    # the benchmark draws "validation" episodes; here they are the chosen training seeds
     seeds = range(args.first, TRAIN_SEEDS.stop)
-    families = [dataclasses.replace(f, validation=seeds) for f in FAMILIES.values()]
-    rows = run_benchmark(
-        families, contenders(["nearest-path", *folders]), args.episodes,
-        progress=not args.no_progress, split="validation",
-    )  # fmt: skip
+    rows = run_on_seeds(["nearest-path", *folders], seeds, args.episodes, not args.no_progress)
     print(format_table(rows))
     if args.json is not None:
         summary = [{k: v for k, v in row.items() if k != "per_episode"} for row in rows]

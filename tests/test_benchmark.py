@@ -279,6 +279,11 @@ def test_cli_bad_input(argv, message, capsys):
     assert message in capsys.readouterr().err
 
 
+def test_run_on_seeds_refuses_held_out_seeds():
+    with pytest.raises(ValueError, match="held-out seeds overlap"):
+        bench.run_on_seeds(["nearest-path"], range(899_999, 900_001), 1)
+
+
 def test_models_in_folders_of_one_name_are_refused(tmp_path):
     shipped = Path(frontier_marl.__file__).parent / "assets" / "models" / "explorer"
     folders = [tmp_path / run / "best" for run in ("run-a", "run-b")]

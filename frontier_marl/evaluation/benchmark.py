@@ -25,7 +25,7 @@ Statistics (T99, T90, success, the paired difference to the best heuristic) are 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +33,7 @@ from frontier_marl.config import EnvConfig, config_to_dict, make_config
 from frontier_marl.evaluation.families import (
     COVERAGE,
     DEFAULT_EPISODES,
+    FAMILIES,
     OBSERVATION_KEYS,
     MapFamily,
     variant_configs,
@@ -254,3 +255,15 @@ def run_benchmark(
                     continue
                 rows.append(summary_row(result))
     return compare(rows)
+
+
+def run_on_seeds(
+    names: Sequence[str], seeds: range, episodes: int, progress: bool = False
+) -> list[dict[str, Any]]:
+    """:func:`run_benchmark` of the policies ``names`` on the first ``episodes`` of ``seeds``
+    of every built-in family, one robot (for the benchmark scripts that choose and probe
+    models on validation or training seeds; :class:`MapFamily` refuses held-out ones)."""
+    families = [replace(fam, validation=seeds) for fam in FAMILIES.values()]
+    return run_benchmark(
+        families, contenders(names), episodes, progress=progress, split="validation"
+    )

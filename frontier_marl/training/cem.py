@@ -106,11 +106,17 @@ def feature_names(cfg: EnvConfig) -> list[str]:
     return names + (list(TEAM_FEATURES) if obs.teammates != "none" else [])
 
 
-def initial_weights(settings: CEMSettings, names: list[str]) -> np.ndarray:
-    unknown = set(settings.init) - set(names)
+def weight_vector(weights: Mapping[str, float], names: list[str], what: str) -> np.ndarray:
+    """``weights`` by feature name as a vector over ``names`` (the others 0); ValueError, naming
+    ``what``, for a name that is not a feature."""
+    unknown = set(weights) - set(names)
     if unknown:
-        raise ValueError(f"cem.init names unknown feature(s) {sorted(unknown)}; features: {names}")
-    return np.array([float(settings.init.get(name, 0.0)) for name in names])
+        raise ValueError(f"{what} names unknown feature(s) {sorted(unknown)}; features: {names}")
+    return np.array([float(weights.get(name, 0.0)) for name in names])
+
+
+def initial_weights(settings: CEMSettings, names: list[str]) -> np.ndarray:
+    return weight_vector(settings.init, names, "cem.init")
 
 
 def play_t99(cfg: EnvConfig, seeds: list[int], weights: np.ndarray) -> tuple[np.ndarray, int]:
@@ -205,11 +211,7 @@ def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experi
     from frontier_marl.training.metadata import save_metadata
 
     cfg = experiment.env_config()
-    names = feature_names(cfg)
-    unknown = set(weights) - set(names)
-    if unknown:
-        raise ValueError(f"unknown feature(s) {sorted(unknown)}; features: {names}")
-    model = linear_model(cfg, np.array([float(weights.get(name, 0.0)) for name in names]))
+    model = linear_model(cfg, weight_vector(weights, feature_names(cfg), "hand-set weights"))
     folder.mkdir(parents=True, exist_ok=True)
     model.save(folder / "model.zip")
     save_metadata(
