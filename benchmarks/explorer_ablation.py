@@ -7,8 +7,11 @@ ones), with ``frontier-marl benchmark``:
 * ``path-only``: the linear slot scorer with the path weight alone, nearest-path among the
   explorer's 12 slots (where CEM starts);
 * ``tour-rule``: the path weight plus a hand-set tour weight of -0.5, no learning;
+* ``near-rule``: the tour rule plus a hand-set ``unknown_near`` weight of -0.5 (where CEM
+  starts), no learning;
 * ``explorer-dqn``: the DQN-trained slot scorer (no tour feature);
-* ``explorer``: the shipped CEM-trained linear scorer (with the tour feature);
+* ``explorer``: the shipped CEM-trained linear scorer (with the tour and unknown-near
+  features);
 * any further model given with ``--models`` (e.g. a CEM run without the tour feature:
   ``frontier-marl train explorer --set env.tour=false --out runs/no-tour``, then
   ``cp -r runs/no-tour/best runs/explorer-no-tour``: a model is labelled by its folder).
@@ -26,7 +29,11 @@ from frontier_marl.cli import main as cli
 from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
 
-HAND_SET = {"path-only": {"path": -1.0}, "tour-rule": {"path": -1.0, "tour": -0.5}}
+HAND_SET = {
+    "path-only": {"path": -1.0},
+    "tour-rule": {"path": -1.0, "tour": -0.5},
+    "near-rule": {"path": -1.0, "tour": -0.5, "unknown_near": -0.5},
+}
 
 
 def save_rules(out: Path) -> list[str]:

@@ -177,10 +177,18 @@ class BatchMDP:
             None if mates is None else mates.reshape(count, -1),
             self.heading[worlds].reshape(count, 2),
             None if motion is None else motion.reshape(count, 2),
+            self._beliefs(worlds),
         )
         if isinstance(batch, dict):
             return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}
         return batch.reshape(*shape, *batch.shape[1:])
+
+    def _beliefs(self, worlds: np.ndarray | slice) -> np.ndarray | None:
+        """Every robot's belief map (its world's), robots of ``worlds`` world after world, for
+        the ``unknown_near`` feature."""
+        if not self.cfg.observation.unknown_near:
+            return None
+        return np.repeat(self.worlds.belief[worlds], self.n_agents, axis=0)
 
     def _teammates(self, worlds: np.ndarray | slice) -> np.ndarray | None:
         layout = self.cfg.observation.teammates

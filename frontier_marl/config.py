@@ -65,6 +65,9 @@ class ObservationConfig:
         turn: with ``features="explorer"``, one more feature per slot: how far the slot's
             target turns the robot away from its motion over its last steps
             (:func:`frontier_marl.slot_features.turn_costs`).
+        unknown_near: with ``features="explorer"``, one more feature per slot: the unknown
+            fraction of the 25 x 25 square around the slot's target
+            (:func:`frontier_marl.slot_features.unknown_near`).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -78,6 +81,7 @@ class ObservationConfig:
     commit: CommitRule = "none"
     tour: bool = False
     turn: bool = False
+    unknown_near: bool = False
 
     def validate(self) -> None:
         check_choice("features", self.features, get_args(FeatureLayout))
@@ -92,9 +96,10 @@ class ObservationConfig:
             "normalize",
             "tour",
             "turn",
+            "unknown_near",
         ):
             check_bool(name, getattr(self, name))
-        for name in ("tour", "turn"):
+        for name in ("tour", "turn", "unknown_near"):
             if getattr(self, name) and self.features != "explorer":
                 raise ValueError(
                     f"{name}=True needs features='explorer' (it is a per-slot feature)"

@@ -213,11 +213,19 @@ class ExplorationMDP:
             None if mates is None else teammate_rows(mates),
             heading,
             motion,
+            self._beliefs(),
         )
         if isinstance(batch, dict):
             agents = range(self.cfg.n_agents)
             return [{key: value[agent] for key, value in batch.items()} for agent in agents]
         return list(batch)
+
+    def _beliefs(self) -> np.ndarray | None:
+        """Every robot's belief map (the shared one), for the ``unknown_near`` feature."""
+        if not self.cfg.observation.unknown_near:
+            return None
+        assert self.world is not None
+        return np.broadcast_to(self.world.belief, (self.cfg.n_agents, *self.world.belief.shape))
 
     def _heading(self, targets: np.ndarray | None, reached: np.ndarray | None) -> np.ndarray:
         """(N, 2) the cells the robots are heading to: the step's targets not reached yet

@@ -35,6 +35,7 @@ from frontier_marl.slot_features import (
     team_features,
     tour_lengths,
     turn_costs,
+    unknown_near,
 )
 
 
@@ -55,8 +56,8 @@ class ObservationEncoder:
         self.features = obs.features
         if self.features == "explorer":
             team = len(TEAM_FEATURES) if self.teammates != "none" else 0
-            self.tour, self.turn = obs.tour, obs.turn
-            extra = int(self.tour) + int(self.turn)
+            self.tour, self.turn, self.unknown_near = obs.tour, obs.turn, obs.unknown_near
+            extra = int(self.tour) + int(self.turn) + int(self.unknown_near)
             self.features_per_slot = len(EXPLORER_FEATURES) + extra + team
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
@@ -113,6 +114,7 @@ class ObservationEncoder:
         teammates: np.ndarray | None = None,
         heading: np.ndarray | None = None,
         motion: np.ndarray | None = None,
+        belief: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
         """The observation of a robot at ``position`` with slot table ``slots``.
 
@@ -120,7 +122,8 @@ class ObservationEncoder:
         targets for ``positions+targets``; needed only when the layout includes teammates.
         ``heading``: the cell the robot is heading to (row -1: none), for the explorer layout.
         ``motion``: its displacement over its last steps (:mod:`frontier_marl.motion`), for
-        the ``turn`` feature (default: none).
+        the ``turn`` feature (default: none). ``belief``: the (H, W) belief map, needed by the
+        ``unknown_near`` feature.
         """
         batch = self.encode_batch(
             SlotArrays.stack([slots]),
@@ -128,6 +131,7 @@ class ObservationEncoder:
             None if teammates is None else np.asarray(teammates).reshape(1, -1),
             None if heading is None else np.asarray(heading).reshape(1, 2),
             None if motion is None else np.asarray(motion).reshape(1, 2),
+            None if belief is None else np.asarray(belief)[None],
         )
         if isinstance(batch, dict):
             return {key: value[0] for key, value in batch.items()}
@@ -140,11 +144,13 @@ class ObservationEncoder:
         teammates: np.ndarray | None = None,
         heading: np.ndarray | None = None,
         motion: np.ndarray | None = None,
+        beliefs: np.ndarray | None = None,
     ) -> np.ndarray | dict[str, np.ndarray]:
         """The observations of M robots at once: ``slots`` with ``(M, n_slots, ...)`` fields,
         ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened per robot,
         ``heading`` (M, 2) the cells they head to (row -1: none; default none), ``motion``
-        (M, 2) their displacements over their last steps (default: none). Returns the
+        (M, 2) their displacements over their last steps (default: none), ``beliefs``
+        (M, H, W) the belief map each robot acts on (needed by ``unknown_near``). Returns the
         ``(M, ...)`` array, or a dict of them, in :attr:`space`'s layout."""
         if self.features == "explorer":
             if heading is None:
@@ -157,6 +163,10 @@ class ObservationEncoder:
                     motion = np.zeros_like(positions)
                 turn = turn_costs(slots, positions, motion)
                 features = np.concatenate([features, turn], axis=-1)
+            if self.unknown_near:
+                if beliefs is None:
+                    raise ValueError("the unknown_near feature needs the robots' belief maps")
+                features = np.concatenate([features, unknown_near(slots, beliefs)], axis=-1)
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
@@ -229,6 +239,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "teammates": cfg.observation.teammates,
             "tour": cfg.observation.tour,
             "turn": cfg.observation.turn,
+            "unknown_near": cfg.observation.unknown_near,
             "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,

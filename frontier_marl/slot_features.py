@@ -28,6 +28,14 @@ With ``turn=True``, one more (:data:`TURN_FEATURE`), after those:
                 slot's target (:func:`turn_costs`): 0 straight ahead, 2 straight back; 0
                 when the robot has not moved in those steps or stands on the target
 
+With ``unknown_near=True``, one more (:data:`UNKNOWN_NEAR_FEATURE`), after those:
+
+``unknown_near``  the unknown cells of the belief in the square of side ``2 * NEAR + 1``
+                  (:data:`NEAR` = 12 cells) centred on the slot's target, as a fraction of
+                  the square's cells (:func:`unknown_near`); cells beyond the map count as
+                  known, so a frontier hemmed in by the map's edge or by known walls scores
+                  low, one that opens onto a large unexplored region high
+
 With teammates observed (``teammates`` other than ``none``), three more per slot
 (:data:`TEAM_FEATURES`), whatever the team's size:
 
@@ -42,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
+from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.slots import SlotArrays
 
 CELLS = 32.0  # the length unit of the features, in cells
@@ -51,6 +60,8 @@ EXPLORER_FEATURES = (
 )  # fmt: skip
 TOUR_FEATURE = "tour"
 TURN_FEATURE = "turn"
+UNKNOWN_NEAR_FEATURE = "unknown_near"
+NEAR = 12  # the half-side of unknown_near's square, in cells
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
 _BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
@@ -137,6 +148,26 @@ def turn_costs(slots: SlotArrays, positions: np.ndarray, motion: np.ndarray) -> 
     cosine = np.divide(dot, scale, out=np.ones_like(scale, dtype=np.float64), where=scale > 0)
     turn = np.where(slots.valid, 1.0 - cosine, 0.0)
     return turn.astype(np.float32)[..., None]
+
+
+def unknown_near(slots: SlotArrays, beliefs: np.ndarray, near: int = NEAR) -> np.ndarray:
+    """(M, n_slots, 1) :data:`UNKNOWN_NEAR_FEATURE` of M robots whose beliefs are ``beliefs``
+    (M, H, W) (0 on padding slots); ``near``: the square's half-side in cells."""
+    count, height, width = beliefs.shape
+    table = np.zeros((count, height + 1, width + 1))  # summed-area table of the unknown cells
+    table[:, 1:, 1:] = (beliefs == UNKNOWN).cumsum(axis=1).cumsum(axis=2)
+    rows, cols = slots.target[..., 0], slots.target[..., 1]
+    top, bottom = np.clip(rows - near, 0, height), np.clip(rows + near + 1, 0, height)
+    left, right = np.clip(cols - near, 0, width), np.clip(cols + near + 1, 0, width)
+    robots = np.arange(count)[:, None]
+    unknown = (
+        table[robots, bottom, right]
+        - table[robots, top, right]
+        - table[robots, bottom, left]
+        + table[robots, top, left]
+    )
+    fraction = np.where(slots.valid, unknown / (2 * near + 1) ** 2, 0.0)
+    return fraction.astype(np.float32)[..., None]
 
 
 def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:

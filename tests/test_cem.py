@@ -27,6 +27,7 @@ CEM_OVERRIDES = [
     "train.families=['random-20', 'rooms-32']",
     "env.tour=true",
     "env.turn=true",
+    "env.unknown_near=true",
 ]
 
 
@@ -86,7 +87,7 @@ def test_batched_rollouts_play_the_single_env_episodes() -> None:
     names = feature_names(cfg)
     weights = np.zeros(len(names))
     weights[names.index("path")], weights[names.index("tour")] = -1.0, -0.5
-    weights[names.index("turn")] = -0.05
+    weights[names.index("turn")], weights[names.index("unknown_near")] = -0.05, -0.5
     seeds = [3, 17, 29]
     t99, decisions = play_t99(cfg, seeds, weights)
     expected = [_single_env_t99(cfg, seed, weights) for seed in seeds]
@@ -143,7 +144,8 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
     assert ablation([*argv, "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
     policies = {row["policy"] for row in rows}
-    assert policies == {"nearest-path", "path-only", "tour-rule", "explorer-dqn", "explorer"}
+    expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "explorer-dqn", "explorer"}
+    assert policies == expected
     assert all(row["seeds"][0] == 800_000 for row in rows)
     tour_rule = json.loads((tmp_path / "models" / "tour-rule" / "model.json").read_text())
     assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
@@ -184,3 +186,29 @@ def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) 
 def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="unknown feature"):
         save_hand_set({"path": -1.0, "tuor": -0.5}, tmp_path, load_experiment("explorer"))
+
+
+def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> None:
+    import runpy
+
+    from frontier_marl.slot_features import NEAR
+    from frontier_marl.training.cem import play_scorer, weight_vector
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_near_probe.py"
+    probe = runpy.run_path(str(script))
+    cfg = load_experiment("explorer", ["env.unknown_near=false"]).env_configs()[2]  # rooms-32
+    seeds = [5, 6, 7]
+    t99, _ = play_scorer(cfg, seeds, probe["scorer"](feature_names(cfg), NEAR, -0.5))
+    featured = load_experiment("explorer", ["env.unknown_near=true"]).env_configs()[2]
+    rule = {"path": -1.0, "tour": -0.5, "unknown_near": -0.5}
+    expected, _ = play_t99(featured, seeds, weight_vector(rule, feature_names(featured), "rule"))
+    assert np.array_equal(t99, expected, equal_nan=True)
+    out = tmp_path / "probe.json"
+    argv = ["--radii", "8", "--weights=-0.4", "--episodes", "1", "--json", str(out)]
+    assert probe["main"](argv) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["family"] for row in rows] == ["random-20", "random-30", "rooms-32", "rooms-64"]
+    assert all(set(row) == {"family", "rule", "R8 W-0.4"} for row in rows)
+    for bad in (["--first", "800000"], ["--radii", "a"]):
+        with pytest.raises(SystemExit):
+            probe["main"](bad)

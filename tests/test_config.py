@@ -71,6 +71,7 @@ BAD_VALUES = [
     ("normalize", "false", "normalize"),
     ("tour", 1, "tour"),
     ("turn", 1, "turn"),
+    ("unknown_near", "yes", "unknown_near"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),
     ("explore_threshold", 1.01, "explore_threshold"),

@@ -18,6 +18,7 @@ from frontier_marl.slot_features import (
     explorer_features,
     tour_lengths,
     turn_costs,
+    unknown_near,
 )
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown"}
@@ -119,6 +120,38 @@ def test_the_turn_feature_follows_the_robots_own_steps() -> None:
         cells.append(env.world.positions[0].copy())
     with pytest.raises(ValueError, match="turn=True needs features='explorer'"):
         make_config("thesis-20x20", turn=True)
+
+
+def test_unknown_near_on_a_hand_made_belief() -> None:
+    from frontier_marl.core.grid import FREE, UNKNOWN
+    from frontier_marl.slot_features import NEAR
+
+    side = 2 * NEAR + 1
+    belief = np.full((40, 60), FREE, dtype=np.int8)
+    belief[:, 30:] = UNKNOWN  # the right half unknown
+    table = _table([(20, 29), (0, 0), (20, 59)], [1, 2, 3], n_slots=4)
+    near = unknown_near(SlotArrays.stack([table]), belief[None])
+    assert near.shape == (1, 4, 1)
+    # (20, 29): columns 30..41 of rows 8..32 unknown; (0, 0): none; (20, 59): the square is
+    # cut by the map's right edge, columns 47..59 of rows 8..32; padding 0
+    expected = [12 * side / side**2, 0.0, 13 * side / side**2, 0.0]
+    assert near[0, :, 0].tolist() == pytest.approx(expected)
+
+
+def test_the_unknown_near_feature_reads_the_shared_belief() -> None:
+    env = frontier_marl.parallel_env(**EXPLORER, tour=True, unknown_near=True, n_agents=2)
+    observations, _ = env.reset(seed=5)
+    for _ in range(8):
+        tables = env.mdp.slot_tables()
+        for agent, name in enumerate(env.agents):
+            slots = observations[name]["slots"]
+            assert slots.shape == (6, len(EXPLORER_FEATURES) + 2)
+            expected = unknown_near(SlotArrays.stack([tables[agent]]), env.world.belief[None])
+            assert np.array_equal(slots[:, -1], expected[0, :, 0])
+        actions = {a: int(np.flatnonzero(observations[a]["action_mask"])[0]) for a in env.agents}
+        observations, *_ = env.step(actions)
+    with pytest.raises(ValueError, match="unknown_near=True needs features='explorer'"):
+        make_config("thesis-20x20", unknown_near=True)
 
 
 def test_team_features_on_a_hand_made_table() -> None:

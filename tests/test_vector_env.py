@@ -122,6 +122,7 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         {"features": "explorer", "commit": "until-progress", "reward": "travel", "max_steps": 40},
         {"features": "explorer", "n_agents": 3, "teammates": "positions+targets", "max_steps": 40},
         {"features": "explorer", "n_agents": 2, "tour": True, "turn": True, "max_steps": 40},
+        {"features": "explorer", "n_agents": 2, "unknown_near": True, "max_steps": 40},
     ],
     ids=[
         "relative-sorted-r1",
@@ -132,6 +133,7 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         "explorer-commit",
         "explorer-team",
         "explorer-tour-turn",
+        "explorer-unknown-near",
     ],  # fmt: skip
 )
 def test_equality_holds_for_every_observation_and_reward_variant(kwargs: dict[str, Any]) -> None:

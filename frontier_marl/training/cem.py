@@ -24,7 +24,7 @@ import dataclasses
 import json
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -37,10 +37,12 @@ from frontier_marl.slot_features import (
     TEAM_FEATURES,
     TOUR_FEATURE,
     TURN_FEATURE,
+    UNKNOWN_NEAR_FEATURE,
 )
 from frontier_marl.training.family_validation import FAILURE
 
 if TYPE_CHECKING:
+    from frontier_marl.envs.vector import FrontierVectorEnv
     from frontier_marl.training.experiment import Experiment
     from frontier_marl.training.train import TrainResult
 
@@ -103,6 +105,7 @@ def feature_names(cfg: EnvConfig) -> list[str]:
         raise ValueError("the linear slot scorer needs features = 'explorer'")
     names = list(EXPLORER_FEATURES) + ([TOUR_FEATURE] if obs.tour else [])
     names += [TURN_FEATURE] if obs.turn else []
+    names += [UNKNOWN_NEAR_FEATURE] if obs.unknown_near else []
     return names + (list(TEAM_FEATURES) if obs.teammates != "none" else [])
 
 
@@ -122,6 +125,19 @@ def initial_weights(settings: CEMSettings, names: list[str]) -> np.ndarray:
 def play_t99(cfg: EnvConfig, seeds: list[int], weights: np.ndarray) -> tuple[np.ndarray, int]:
     """One robot's T99 on the episodes reset with ``seeds`` (NaN where 99 % was not reached)
     when it takes the valid slot of highest ``features @ weights``; also the decisions made."""
+    return play_scorer(
+        cfg, seeds, lambda observations, env: observations["slots"].astype(np.float64) @ weights
+    )
+
+
+def play_scorer(
+    cfg: EnvConfig,
+    seeds: list[int],
+    score: Callable[[dict[str, np.ndarray], FrontierVectorEnv], np.ndarray],
+) -> tuple[np.ndarray, int]:
+    """:func:`play_t99` with any slot scorer: ``score(observations, env)`` gives the (N,
+    n_slots) scores of the N episodes' slots (``env`` for scorers that read more than the
+    observation, e.g. the belief maps); the valid slot of highest score is taken."""
     from frontier_marl.envs.vector import FrontierVectorEnv
 
     if cfg.n_agents != 1:
@@ -132,7 +148,7 @@ def play_t99(cfg: EnvConfig, seeds: list[int], weights: np.ndarray) -> tuple[np.
     ended = np.zeros(len(seeds), dtype=bool)
     decisions = 0
     while not ended.all():
-        scores = observations["slots"].astype(np.float64) @ weights
+        scores = np.asarray(score(observations, env), dtype=np.float64)
         scores = np.where(observations["action_mask"] > 0, scores, -np.inf)
         observations, _, terminated, truncated, info = env.step(scores.argmax(axis=1))
         decisions += int((~ended).sum())
