@@ -18,24 +18,29 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.families import TRAIN_SEEDS
 from frontier_marl.slot_features import unknown_near
-from frontier_marl.training.cem import feature_names, play_scorer, relative_t99
+from frontier_marl.training.cem import feature_names, play_scorer, relative_t99, weight_vector
 from frontier_marl.training.experiment import load_experiment
 
 RULE = {"path": -1.0, "tour": -0.5}
 
 
-def scorer(names: list[str], radius: int, weight: float, rule: dict = RULE):  # noqa: ANN201
+Scorer = Callable[[dict[str, np.ndarray], FrontierVectorEnv], np.ndarray]
+
+
+def scorer(names: list[str], radius: int, weight: float, rule: dict = RULE) -> Scorer:
     """``rule``'s linear scores plus ``weight`` times the unknown share of the square of
     half-side ``radius`` around each slot's target."""
-    linear = np.array([rule.get(name, 0.0) for name in names])
+    linear = weight_vector(rule, names, "the probe's rule")
 
-    def score(observations: dict[str, np.ndarray], env) -> np.ndarray:  # noqa: ANN001
+    def score(observations: dict[str, np.ndarray], env: FrontierVectorEnv) -> np.ndarray:
         scores = observations["slots"].astype(np.float64) @ linear
         if weight:
             slots = env.mdp.slots.rows(slice(None))

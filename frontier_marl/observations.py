@@ -28,10 +28,9 @@ from gymnasium import spaces
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.slot_features import (
-    EXPLORER_FEATURES,
-    TEAM_FEATURES,
     explorer_features,
     explorer_space,
+    slot_feature_names,
     team_features,
     tour_lengths,
     turn_costs,
@@ -55,10 +54,8 @@ class ObservationEncoder:
         self.normalize = obs.normalize
         self.features = obs.features
         if self.features == "explorer":
-            team = len(TEAM_FEATURES) if self.teammates != "none" else 0
             self.tour, self.turn, self.unknown_near = obs.tour, obs.turn, obs.unknown_near
-            extra = int(self.tour) + int(self.turn) + int(self.unknown_near)
-            self.features_per_slot = len(EXPLORER_FEATURES) + extra + team
+            self.features_per_slot = len(slot_feature_names(obs))
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
         height, width = cfg.height, cfg.width

@@ -47,11 +47,16 @@ With teammates observed (``teammates`` other than ``none``), three more per slot
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from gymnasium import spaces
 
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.slots import SlotArrays
+
+if TYPE_CHECKING:
+    from frontier_marl.config import ObservationConfig
 
 CELLS = 32.0  # the length unit of the features, in cells
 EXPLORER_FEATURES = (
@@ -65,6 +70,16 @@ NEAR = 12  # the half-side of unknown_near's square, in cells
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
 _BOUND = 1024.0  # far above any value on a 4096 x 4096 grid
+
+
+def slot_feature_names(observation: ObservationConfig) -> list[str]:
+    """The names of the explorer layout's per-slot features under ``observation``, in the
+    order the encoder writes them."""
+    names = list(EXPLORER_FEATURES)
+    names += [TOUR_FEATURE] if observation.tour else []
+    names += [TURN_FEATURE] if observation.turn else []
+    names += [UNKNOWN_NEAR_FEATURE] if observation.unknown_near else []
+    return names + (list(TEAM_FEATURES) if observation.teammates != "none" else [])
 
 
 def explorer_space(n_slots: int, n_features: int = len(EXPLORER_FEATURES)) -> spaces.Dict:

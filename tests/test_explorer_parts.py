@@ -154,6 +154,21 @@ def test_the_unknown_near_feature_reads_the_shared_belief() -> None:
         make_config("thesis-20x20", unknown_near=True)
 
 
+def test_slot_feature_names_follow_the_encoders_columns() -> None:
+    from frontier_marl.slot_features import slot_feature_names
+
+    kwargs = {"tour": True, "turn": True, "unknown_near": True, "n_agents": 2}
+    env = frontier_marl.parallel_env(**EXPLORER, **kwargs, teammates="positions+targets")
+    observations, _ = env.reset(seed=6)
+    names = slot_feature_names(env.config.observation)
+    slots = observations["robot_0"]["slots"]
+    assert slots.shape[1] == len(names) == len(EXPLORER_FEATURES) + 6
+    table = SlotArrays.stack([env.mdp.slot_tables()[0]])
+    expected = unknown_near(table, env.world.belief[None])[0, :, 0]
+    assert np.array_equal(slots[:, names.index("unknown_near")], expected)
+    assert np.array_equal(slots[:, names.index("tour")], tour_lengths(table)[0, :, 0])
+
+
 def test_team_features_on_a_hand_made_table() -> None:
     from frontier_marl.slot_features import FAR, TEAM_FEATURES, team_features
 

@@ -32,13 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.slot_features import (
-    EXPLORER_FEATURES,
-    TEAM_FEATURES,
-    TOUR_FEATURE,
-    TURN_FEATURE,
-    UNKNOWN_NEAR_FEATURE,
-)
+from frontier_marl.slot_features import slot_feature_names
 from frontier_marl.training.family_validation import FAILURE
 
 if TYPE_CHECKING:
@@ -103,10 +97,7 @@ def feature_names(cfg: EnvConfig) -> list[str]:
     obs = cfg.observation
     if obs.features != "explorer":
         raise ValueError("the linear slot scorer needs features = 'explorer'")
-    names = list(EXPLORER_FEATURES) + ([TOUR_FEATURE] if obs.tour else [])
-    names += [TURN_FEATURE] if obs.turn else []
-    names += [UNKNOWN_NEAR_FEATURE] if obs.unknown_near else []
-    return names + (list(TEAM_FEATURES) if obs.teammates != "none" else [])
+    return slot_feature_names(obs)
 
 
 def weight_vector(weights: Mapping[str, float], names: list[str], what: str) -> np.ndarray:
