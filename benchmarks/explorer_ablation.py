@@ -7,10 +7,11 @@ ones), with ``frontier-marl benchmark``:
 * ``path-only``: the linear slot scorer with the path weight alone, nearest-path among the
   explorer's 12 slots (where CEM starts);
 * ``tour-rule``: the path weight plus a hand-set tour weight of -0.5, no learning;
-* ``near-rule``: the tour rule plus a hand-set ``unknown_near`` weight of -0.5 (where CEM
-  starts), no learning;
+* ``near-rule``: the tour rule plus a hand-set ``unknown_near`` weight of -0.5, no learning;
+* ``fill-rule``: the near rule plus hand-set ``size`` 0.8 and ``fill`` -0.4 weights (where
+  CEM starts): long frontier pieces before specks on fine grids, about neutral on coarse ones;
 * ``explorer-dqn``: the DQN-trained slot scorer (no tour feature);
-* ``explorer``: the shipped CEM-trained linear scorer (with the tour and unknown-near
+* ``explorer``: the shipped CEM-trained linear scorer (with the tour, unknown-near and fill
   features);
 * any further model given with ``--models`` (e.g. a CEM run without the tour feature:
   ``frontier-marl train explorer --set env.tour=false --out runs/no-tour``, then
@@ -33,6 +34,7 @@ HAND_SET = {
     "path-only": {"path": -1.0},
     "tour-rule": {"path": -1.0, "tour": -0.5},
     "near-rule": {"path": -1.0, "tour": -0.5, "unknown_near": -0.5},
+    "fill-rule": {"path": -1.0, "tour": -0.5, "unknown_near": -0.5, "size": 0.8, "fill": -0.4},
 }
 
 

@@ -68,6 +68,8 @@ class ObservationConfig:
         unknown_near: with ``features="explorer"``, one more feature per slot: the unknown
             fraction of the 25 x 25 square around the slot's target
             (:func:`frontier_marl.slot_features.unknown_near`).
+        fill: with ``features="explorer"``, one more feature per slot: the cluster's size over
+            ``max_cluster_cells`` (:func:`frontier_marl.slot_features.cluster_fill`).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -82,6 +84,7 @@ class ObservationConfig:
     tour: bool = False
     turn: bool = False
     unknown_near: bool = False
+    fill: bool = False
 
     def validate(self) -> None:
         check_choice("features", self.features, get_args(FeatureLayout))
@@ -97,9 +100,10 @@ class ObservationConfig:
             "tour",
             "turn",
             "unknown_near",
+            "fill",
         ):
             check_bool(name, getattr(self, name))
-        for name in ("tour", "turn", "unknown_near"):
+        for name in ("tour", "turn", "unknown_near", "fill"):
             if getattr(self, name) and self.features != "explorer":
                 raise ValueError(
                     f"{name}=True needs features='explorer' (it is a per-slot feature)"
@@ -224,6 +228,10 @@ class EnvConfig:
         map_seed: seed of the static layout, recorded so results are comparable across runs.
         map_path: load the (static) layout from a .txt, .pgm or .png file instead of drawing
             it; the file sets ``height`` and ``width``.
+        map_scale: draw the layout at ``height / k`` x ``width / k`` cells and make each of its
+            cells a k x k block: the same kind of floor plan on a grid k times finer (walls
+            and doors k cells thick, rooms k times wider). 1 (the default) draws it cell by
+            cell; ``height`` and ``width`` must be multiples of k; generated layouts only.
         perception_range: sensor range r in cells.
         sensor: ``square`` (Chebyshev window, no occlusion) or ``raycast`` (Euclidean disc with
             line of sight through free cells). Open choice; ``raycast`` by calibration.
@@ -249,6 +257,7 @@ class EnvConfig:
     map_mode: MapMode = "static"
     map_seed: int = 0
     map_path: str | None = None
+    map_scale: int = 1
     perception_range: int = 3
     sensor: SensorModel = "raycast"
     cells_per_step: int | str = 1
@@ -271,9 +280,17 @@ class EnvConfig:
         check_range("obstacle_prob", self.obstacle_prob, 0.0, 0.9)
         check_range("obstacle_prob_spread", self.obstacle_prob_spread, 0.0, 0.5)
         check_choice("start_cells", self.start_cells, get_args(StartCells))
-        if self.map_generator == "rooms" and min(self.height, self.width) < 5:
+        check_int("map_scale", self.map_scale, 1, 64)
+        if self.height % self.map_scale or self.width % self.map_scale:
             raise ValueError(
-                f"map_generator='rooms' needs height and width >= 5, got {self.height}x{self.width}"
+                f"height and width must be multiples of map_scale={self.map_scale}, "
+                f"got {self.height}x{self.width}"
+            )
+        layout = (self.height // self.map_scale, self.width // self.map_scale)
+        if self.map_generator == "rooms" and min(layout) < 5:
+            raise ValueError(
+                "map_generator='rooms' needs a layout of at least 5x5 cells (height and width "
+                f"/ map_scale), got {layout[0]}x{layout[1]}"
             )
         check_choice("map_mode", self.map_mode, get_args(MapMode))
         check_int("map_seed", self.map_seed, 0)
@@ -284,6 +301,8 @@ class EnvConfig:
                 raise ValueError(
                     "map_mode must be 'static' with map_path (a file holds one fixed layout)"
                 )
+            if self.map_scale != 1:
+                raise ValueError("map_scale applies to generated layouts, not to map_path")
         check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
         check_choice("sensor", self.sensor, get_args(SensorModel))
         if self.cells_per_step != FULL_PATH:

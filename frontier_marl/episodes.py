@@ -56,13 +56,17 @@ class EpisodeSource:
 
     def _generate(self, rng: np.random.Generator) -> np.ndarray:
         cfg = self.cfg
+        scale = cfg.map_scale
+        height, width = cfg.height // scale, cfg.width // scale
         if cfg.map_generator == "rooms":
-            return rooms_map(cfg.height, cfg.width, rng)
-        density = cfg.obstacle_prob
-        if cfg.obstacle_prob_spread > 0 and cfg.map_mode == "dynamic":
-            low = max(0.0, density - cfg.obstacle_prob_spread)
-            density = float(rng.uniform(low, min(0.9, density + cfg.obstacle_prob_spread)))
-        return random_obstacle_map(cfg.height, cfg.width, density, rng)
+            layout = rooms_map(height, width, rng)
+        else:
+            density = cfg.obstacle_prob
+            if cfg.obstacle_prob_spread > 0 and cfg.map_mode == "dynamic":
+                low = max(0.0, density - cfg.obstacle_prob_spread)
+                density = float(rng.uniform(low, min(0.9, density + cfg.obstacle_prob_spread)))
+            layout = random_obstacle_map(height, width, density, rng)
+        return layout.repeat(scale, axis=0).repeat(scale, axis=1) if scale > 1 else layout
 
     def draw(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """``(true_grid, starts, start_region)``: the start region is the free region

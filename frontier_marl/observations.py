@@ -28,6 +28,7 @@ from gymnasium import spaces
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.slot_features import (
+    cluster_fill,
     explorer_features,
     explorer_space,
     slot_feature_names,
@@ -55,6 +56,7 @@ class ObservationEncoder:
         self.features = obs.features
         if self.features == "explorer":
             self.tour, self.turn, self.unknown_near = obs.tour, obs.turn, obs.unknown_near
+            self.fill = obs.fill
             self.features_per_slot = len(slot_feature_names(obs))
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
@@ -164,6 +166,9 @@ class ObservationEncoder:
                 if beliefs is None:
                     raise ValueError("the unknown_near feature needs the robots' belief maps")
                 features = np.concatenate([features, unknown_near(slots, beliefs)], axis=-1)
+            if self.fill:
+                fill = cluster_fill(slots, self.cfg.max_cluster_cells)
+                features = np.concatenate([features, fill], axis=-1)
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
@@ -237,6 +242,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "tour": cfg.observation.tour,
             "turn": cfg.observation.turn,
             "unknown_near": cfg.observation.unknown_near,
+            "fill": cfg.observation.fill,
             "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,

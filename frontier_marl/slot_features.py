@@ -36,6 +36,14 @@ With ``unknown_near=True``, one more (:data:`UNKNOWN_NEAR_FEATURE`), after those
                   known, so a frontier hemmed in by the map's edge or by known walls scores
                   low, one that opens onto a large unexplored region high
 
+With ``fill=True``, one more (:data:`FILL_FEATURE`), after those:
+
+``fill``        the cluster's frontier cells / the env's ``max_cluster_cells`` (its split size,
+                2r + 2 by default): 1 for a full piece of a long frontier, near 0 for a speck
+                of a few cells; unlike ``size``, it reads alike on a coarse grid and on a finer
+                grid of the same floor plan (where the sensor and the pieces span more cells
+                and shadows leave more specks) (:func:`cluster_fill`)
+
 With teammates observed (``teammates`` other than ``none``), three more per slot
 (:data:`TEAM_FEATURES`), whatever the team's size:
 
@@ -66,6 +74,7 @@ EXPLORER_FEATURES = (
 TOUR_FEATURE = "tour"
 TURN_FEATURE = "turn"
 UNKNOWN_NEAR_FEATURE = "unknown_near"
+FILL_FEATURE = "fill"
 NEAR = 12  # the half-side of unknown_near's square, in cells
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
@@ -79,6 +88,7 @@ def slot_feature_names(observation: ObservationConfig) -> list[str]:
     names += [TOUR_FEATURE] if observation.tour else []
     names += [TURN_FEATURE] if observation.turn else []
     names += [UNKNOWN_NEAR_FEATURE] if observation.unknown_near else []
+    names += [FILL_FEATURE] if observation.fill else []
     return names + (list(TEAM_FEATURES) if observation.teammates != "none" else [])
 
 
@@ -183,6 +193,13 @@ def unknown_near(slots: SlotArrays, beliefs: np.ndarray, near: int = NEAR) -> np
     )
     fraction = np.where(slots.valid, unknown / (2 * near + 1) ** 2, 0.0)
     return fraction.astype(np.float32)[..., None]
+
+
+def cluster_fill(slots: SlotArrays, max_cluster_cells: int) -> np.ndarray:
+    """(M, n_slots, 1) :data:`FILL_FEATURE` of M robots: each slot's cluster size over
+    ``max_cluster_cells`` (0 on padding slots)."""
+    fill = np.where(slots.valid, slots.size / max_cluster_cells, 0.0)
+    return fill.astype(np.float32)[..., None]
 
 
 def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:

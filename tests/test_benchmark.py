@@ -152,22 +152,25 @@ def test_teams_are_also_compared_by_makespan():
 
 
 def test_families_and_seed_ranges():
-    assert list(map_families.FAMILIES) == ["random-20", "random-30", "rooms-32", "rooms-64"]
+    assert list(map_families.FAMILIES) == [
+        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine"
+    ]  # fmt: skip
     for fam in map_families.FAMILIES.values():
         held = set(fam.heldout)
         assert not held & set(fam.train[-1000:]) and not held & set(fam.validation)
         assert fam.train.stop <= fam.validation.start and fam.validation.stop <= fam.heldout.start
         assert fam.seeds(3) == [900_000, 900_001, 900_002]
     shapes = {
-        name: (c.height, c.width, c.perception_range, c.map_generator, c.map_mode)
+        name: (c.height, c.width, c.map_scale, c.perception_range, c.map_generator, c.map_mode)
         for name in map_families.FAMILIES
         for c in map_families.variant_configs(map_families.family(name))
     }
     assert shapes == {
-        "random-20": (20, 20, 3, "random", "dynamic"),
-        "random-30": (30, 30, 5, "random", "dynamic"),
-        "rooms-32": (32, 32, 3, "rooms", "dynamic"),
-        "rooms-64": (64, 64, 5, "rooms", "dynamic"),
+        "random-20": (20, 20, 1, 3, "random", "dynamic"),
+        "random-30": (30, 30, 1, 5, "random", "dynamic"),
+        "rooms-32": (32, 32, 1, 3, "rooms", "dynamic"),
+        "rooms-64": (64, 64, 1, 5, "rooms", "dynamic"),
+        "rooms-96-fine": (96, 96, 3, 13, "rooms", "dynamic"),
     }
     (cfg,) = map_families.variant_configs(
         map_families.family("rooms-64"), {"perception_range": 4}, agents=2
@@ -332,3 +335,23 @@ def test_cli_shipped_model_keeps_its_observation_settings(tmp_path, capsys):
     for key in ("perception_range", "cells_per_step", "max_steps", "explore_threshold"):
         assert model["config"][key] == heuristic["config"][key]
     assert model["best_heuristic"] == "nearest-path" and not model["heuristic"]
+
+
+def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
+    tmp_path: Path,
+) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "resolution_sweep.py"
+    sweep = runpy.run_path(str(script))["main"]
+    out = tmp_path / "sweep.json"
+    argv = ["--scales", "1,2", "--episodes", "1", "--policies", "cost-utility,nearest-path"]
+    assert sweep([*argv, "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [(row["scale"], row["perception_range"], row["policy"]) for row in rows] == [
+        (1, 4, "cost-utility"), (1, 4, "nearest-path"),
+        (2, 9, "cost-utility"), (2, 9, "nearest-path"),
+    ]  # fmt: skip
+    assert all(row["success"] == 1 for row in rows)
+    with pytest.raises(SystemExit):
+        sweep(["--scales", "x"])

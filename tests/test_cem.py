@@ -28,6 +28,7 @@ CEM_OVERRIDES = [
     "env.tour=true",
     "env.turn=true",
     "env.unknown_near=true",
+    "env.fill=true",
 ]
 
 
@@ -88,6 +89,7 @@ def test_batched_rollouts_play_the_single_env_episodes() -> None:
     weights = np.zeros(len(names))
     weights[names.index("path")], weights[names.index("tour")] = -1.0, -0.5
     weights[names.index("turn")], weights[names.index("unknown_near")] = -0.05, -0.5
+    weights[names.index("size")], weights[names.index("fill")] = 0.8, -0.4
     seeds = [3, 17, 29]
     t99, decisions = play_t99(cfg, seeds, weights)
     expected = [_single_env_t99(cfg, seed, weights) for seed in seeds]
@@ -144,8 +146,8 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
     assert ablation([*argv, "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
     policies = {row["policy"] for row in rows}
-    expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "explorer-dqn", "explorer"}
-    assert policies == expected
+    expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "fill-rule", "explorer-dqn"}
+    assert policies == expected | {"explorer"}
     assert all(row["seeds"][0] == 800_000 for row in rows)
     tour_rule = json.loads((tmp_path / "models" / "tour-rule" / "model.json").read_text())
     assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
@@ -207,7 +209,9 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
     argv = ["--radii", "8", "--weights=-0.4", "--episodes", "1", "--json", str(out)]
     assert probe["main"](argv) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert [row["family"] for row in rows] == ["random-20", "random-30", "rooms-32", "rooms-64"]
+    assert [row["family"] for row in rows] == [
+        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine"
+    ]  # fmt: skip
     assert all(set(row) == {"family", "rule", "R8 W-0.4"} for row in rows)
     for bad in (["--first", "800000"], ["--radii", "a"]):
         with pytest.raises(SystemExit):

@@ -40,6 +40,9 @@ BAD_VALUES = [
     ("map_mode", "moving", "map_mode"),
     ("map_seed", -1, "map_seed"),
     ("map_seed", 0.5, "map_seed"),
+    ("map_scale", 0, "map_scale"),
+    ("map_scale", 3, "map_scale"),  # 20x20 is not a multiple of 3
+    ("map_scale", 1.5, "map_scale"),
     *[pytest.param("map_path", value, "map_path") for value in ("/nonexistent/map.txt", 5)],
     ("perception_range", 0, "perception_range"),
     ("perception_range", 21, "perception_range"),  # larger than the 20x20 map
@@ -72,6 +75,7 @@ BAD_VALUES = [
     ("tour", 1, "tour"),
     ("turn", 1, "turn"),
     ("unknown_near", "yes", "unknown_near"),
+    ("fill", 1, "fill"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),
     ("explore_threshold", 1.01, "explore_threshold"),
@@ -194,6 +198,17 @@ def test_map_path_contradicting_shape_raises(map_file):
 def test_map_path_needs_static_mode(map_file):
     with pytest.raises(ValueError, match="map_path"):
         make_config(map_path=map_file, map_mode="dynamic")
+
+
+def test_map_path_refuses_map_scale(map_file):
+    with pytest.raises(ValueError, match="map_scale"):
+        make_config(map_path=map_file, map_scale=2)
+
+
+def test_map_scale_needs_a_rooms_layout_of_five_cells():
+    with pytest.raises(ValueError, match="5x5"):
+        make_config(map_generator="rooms", height=16, width=16, map_scale=4)
+    assert make_config(map_generator="rooms", height=20, width=20, map_scale=4).map_scale == 4
 
 
 def test_map_path_round_trip(map_file):

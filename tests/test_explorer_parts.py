@@ -15,7 +15,9 @@ from frontier_marl.rewards import StepEvents, step_outcome
 from frontier_marl.slot_features import (
     CELLS,
     EXPLORER_FEATURES,
+    cluster_fill,
     explorer_features,
+    slot_feature_names,
     tour_lengths,
     turn_costs,
     unknown_near,
@@ -154,18 +156,44 @@ def test_the_unknown_near_feature_reads_the_shared_belief() -> None:
         make_config("thesis-20x20", unknown_near=True)
 
 
-def test_slot_feature_names_follow_the_encoders_columns() -> None:
-    from frontier_marl.slot_features import slot_feature_names
+def test_cluster_fill_on_a_hand_made_table() -> None:
+    table = _table([(0, 4), (3, 0)], [6, 3])  # clusters of 3 cells
+    fill = cluster_fill(SlotArrays.stack([table]), max_cluster_cells=12)
+    assert fill.shape == (1, 4, 1)
+    assert fill[0, :, 0].tolist() == pytest.approx([0.25, 0.25, 0.0, 0.0])
 
-    kwargs = {"tour": True, "turn": True, "unknown_near": True, "n_agents": 2}
+
+def test_the_fill_feature_is_the_size_over_the_split_size_on_a_finer_grid() -> None:
+    env = frontier_marl.parallel_env(
+        **EXPLORER, map_generator="rooms", fill=True, height=60, width=60, map_scale=3,
+        perception_range=6, max_cluster_cells=14, map_mode="dynamic",
+    )  # fmt: skip
+    column = slot_feature_names(env.config.observation).index("fill")
+    observations, _ = env.reset(seed=0)
+    for _ in range(10):
+        table = env.mdp.slot_tables()[0]
+        slots = observations["robot_0"]["slots"]
+        expected = np.where(table.valid, table.size / 14, 0.0)
+        assert slots[:, column] == pytest.approx(expected)
+        assert (slots[:, column] <= 1).all()
+        action = int(np.flatnonzero(observations["robot_0"]["action_mask"])[0])
+        observations, *_ = env.step({"robot_0": action})
+    with pytest.raises(ValueError, match="fill=True needs features='explorer'"):
+        make_config("thesis-20x20", fill=True)
+
+
+def test_slot_feature_names_follow_the_encoders_columns() -> None:
+    kwargs = {"tour": True, "turn": True, "unknown_near": True, "fill": True, "n_agents": 2}
     env = frontier_marl.parallel_env(**EXPLORER, **kwargs, teammates="positions+targets")
     observations, _ = env.reset(seed=6)
     names = slot_feature_names(env.config.observation)
     slots = observations["robot_0"]["slots"]
-    assert slots.shape[1] == len(names) == len(EXPLORER_FEATURES) + 6
+    assert slots.shape[1] == len(names) == len(EXPLORER_FEATURES) + 7
     table = SlotArrays.stack([env.mdp.slot_tables()[0]])
     expected = unknown_near(table, env.world.belief[None])[0, :, 0]
     assert np.array_equal(slots[:, names.index("unknown_near")], expected)
+    fill = cluster_fill(table, env.config.max_cluster_cells)[0, :, 0]
+    assert np.array_equal(slots[:, names.index("fill")], fill)
     assert np.array_equal(slots[:, names.index("tour")], tour_lengths(table)[0, :, 0])
 
 

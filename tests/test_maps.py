@@ -94,6 +94,20 @@ def test_env_with_the_rooms_generator_static_and_dynamic():
     assert not np.array_equal(*layouts)
 
 
+@pytest.mark.parametrize("generator", ["rooms", "random"])
+def test_map_scale_draws_the_same_layout_in_blocks(generator):
+    coarse = frontier_marl.parallel_env(map_generator=generator, height=12, width=10, map_seed=5)
+    fine = frontier_marl.parallel_env(
+        map_generator=generator, height=36, width=30, map_seed=5, map_scale=3
+    )
+    coarse.reset(seed=0)
+    fine.reset(seed=0)
+    layout = np.array(coarse.world.true_grid)
+    blocks = np.kron(layout, np.ones((3, 3), dtype=bool))
+    assert np.array_equal(fine.world.true_grid, blocks)
+    assert fine.world.true_grid.shape == (36, 30)
+
+
 # ----------------------------------------------------------------- text maps
 
 

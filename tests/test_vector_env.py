@@ -122,7 +122,13 @@ def test_world_i_plays_the_parallel_env_seeded_s_plus_i(
         {"features": "explorer", "commit": "until-progress", "reward": "travel", "max_steps": 40},
         {"features": "explorer", "n_agents": 3, "teammates": "positions+targets", "max_steps": 40},
         {"features": "explorer", "n_agents": 2, "tour": True, "turn": True, "max_steps": 40},
-        {"features": "explorer", "n_agents": 2, "unknown_near": True, "max_steps": 40},
+        {
+            "features": "explorer",
+            "n_agents": 2,
+            "unknown_near": True,
+            "fill": True,
+            "max_steps": 40,
+        },
     ],
     ids=[
         "relative-sorted-r1",

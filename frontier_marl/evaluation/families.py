@@ -83,8 +83,12 @@ def _family(name: str, description: str, **env: Any) -> MapFamily:
 
 
 #: The built-in families: the thesis's two random geometries (dynamic, 10 % obstacles on
-#: average: each layout's density drawn from U(0, 0.3)) and rooms and corridors at two sizes.
+#: average: each layout's density drawn from U(0, 0.3)), rooms and corridors at two sizes, and
+#: rooms-32 layouts on a 3x finer grid: walls and doors 3 cells thick and a sensor that spans
+#: 13 cells, as on real floor plans at 0.1 m a cell (the Explore-Bench regime), where the
+#: frontier breaks into long pieces and the specks that shadows leave.
 _ROOMS_64 = {"height": 64, "width": 64, "perception_range": 5}
+_ROOMS_96_FINE = {"height": 96, "width": 96, "map_scale": 3, "perception_range": 13}
 FAMILIES: dict[str, MapFamily] = {
     f.name: f
     for f in (
@@ -92,6 +96,12 @@ FAMILIES: dict[str, MapFamily] = {
         _family("random-30", "30x30 random obstacles, r = 5", preset="thesis-30x30"),
         _family("rooms-32", "32x32 rooms and corridors, r = 3", preset="rooms-32"),
         _family("rooms-64", "64x64 rooms and corridors, r = 5", preset="rooms-32", **_ROOMS_64),
+        _family(
+            "rooms-96-fine",
+            "96x96 rooms and corridors on a 3x finer grid (map_scale = 3), r = 13",
+            preset="rooms-32",
+            **_ROOMS_96_FINE,
+        ),
     )
 }
 
