@@ -60,6 +60,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from gymnasium import spaces
 
+from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.slots import SlotArrays
 
@@ -175,12 +176,26 @@ def turn_costs(slots: SlotArrays, positions: np.ndarray, motion: np.ndarray) -> 
     return turn.astype(np.float32)[..., None]
 
 
+@compiled
+def unknown_tables(beliefs: np.ndarray) -> np.ndarray:
+    """(M, H + 1, W + 1) summed-area tables of the unknown cells of M beliefs (M, H, W):
+    ``table[m, r, c]`` counts the unknown cells of rows < r and columns < c."""
+    count, height, width = beliefs.shape
+    table = np.zeros((count, height + 1, width + 1), dtype=np.int32)
+    for m in range(count):
+        for r in range(height):
+            row = 0
+            for c in range(width):
+                row += beliefs[m, r, c] == UNKNOWN
+                table[m, r + 1, c + 1] = table[m, r, c + 1] + row
+    return table
+
+
 def unknown_near(slots: SlotArrays, beliefs: np.ndarray, near: int = NEAR) -> np.ndarray:
     """(M, n_slots, 1) :data:`UNKNOWN_NEAR_FEATURE` of M robots whose beliefs are ``beliefs``
     (M, H, W) (0 on padding slots); ``near``: the square's half-side in cells."""
     count, height, width = beliefs.shape
-    table = np.zeros((count, height + 1, width + 1))  # summed-area table of the unknown cells
-    table[:, 1:, 1:] = (beliefs == UNKNOWN).cumsum(axis=1).cumsum(axis=2)
+    table = unknown_tables(beliefs)
     rows, cols = slots.target[..., 0], slots.target[..., 1]
     top, bottom = np.clip(rows - near, 0, height), np.clip(rows + near + 1, 0, height)
     left, right = np.clip(cols - near, 0, width), np.clip(cols + near + 1, 0, width)

@@ -355,3 +355,18 @@ def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
     assert all(row["success"] == 1 for row in rows)
     with pytest.raises(SystemExit):
         sweep(["--scales", "x"])
+
+
+def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_explorer_features.py"
+    bench = runpy.run_path(str(script))
+    out = tmp_path / "cost.json"
+    argv = ["--families", "random-20", "--worlds", "2", "--seconds", "0.05", "--json", str(out)]
+    assert bench["main"](argv) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["layout"] for row in rows] == list(bench["LAYOUTS"])
+    assert all(row["decisions_per_s"] > 0 for row in rows)
+    with pytest.raises(SystemExit):
+        bench["main"](["--worlds", "0"])

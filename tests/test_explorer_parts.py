@@ -140,6 +140,18 @@ def test_unknown_near_on_a_hand_made_belief() -> None:
     assert near[0, :, 0].tolist() == pytest.approx(expected)
 
 
+def test_unknown_tables_match_numpys_summed_area_tables() -> None:
+    from frontier_marl.core.grid import UNKNOWN
+    from frontier_marl.slot_features import unknown_tables
+
+    for seed in range(5):
+        rng = np.random.default_rng(seed)
+        beliefs = rng.integers(-1, 2, size=(3, 7 + seed, 11 - seed)).astype(np.int8)
+        expected = np.zeros((3, 8 + seed, 12 - seed), dtype=np.int64)
+        expected[:, 1:, 1:] = (beliefs == UNKNOWN).cumsum(axis=1).cumsum(axis=2)
+        assert np.array_equal(unknown_tables(beliefs), expected)
+
+
 def test_the_unknown_near_feature_reads_the_shared_belief() -> None:
     env = frontier_marl.parallel_env(**EXPLORER, tour=True, unknown_near=True, n_agents=2)
     observations, _ = env.reset(seed=5)
