@@ -14,15 +14,15 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import time
+import runpy
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 import frontier_marl
 from frontier_marl.config import config_to_dict
 from frontier_marl.evaluation.families import family, variant_configs
+
+_BENCH_VECTOR_ENV = runpy.run_path(str(Path(__file__).with_name("bench_vector_env.py")))
 
 #: The observation layouts compared, each the previous one plus one feature.
 LAYOUTS: dict[str, dict[str, Any]] = {
@@ -35,21 +35,17 @@ LAYOUTS: dict[str, dict[str, Any]] = {
 
 
 def decisions_per_second(kwargs: dict[str, Any], worlds: int, seconds: float) -> float:
-    """Random valid decisions per second of ``worlds`` batched worlds built from ``kwargs``."""
-    env = frontier_marl.vector_env(worlds, info="mask", **kwargs)
-    rng = np.random.default_rng(0)
-    start = time.perf_counter()
+    """Random valid decisions per second of ``worlds`` batched worlds built from ``kwargs``
+    (``bench_vector_env.py``'s measurement)."""
+    return float(_BENCH_VECTOR_ENV["rate_batched"](kwargs, worlds, seconds))
+
+
+def warm_up(kwargs: dict[str, Any]) -> None:
+    """Reset and step two worlds once, so that compiling stays out of the timed figures."""
+    env = frontier_marl.vector_env(2, info="mask", **kwargs)
     _, infos = env.reset(seed=0)
-    timed, decisions = time.perf_counter() - start, 0
-    while decisions == 0 or timed < seconds:
-        masks = infos["action_mask"]
-        actions = (rng.random(masks.shape) * masks).argmax(axis=1)
-        start = time.perf_counter()
-        _, _, _, _, infos = env.step(actions)
-        timed += time.perf_counter() - start
-        decisions += env.num_envs
+    env.step(infos["action_mask"].argmax(axis=1))
     env.close()
-    return decisions / timed
 
 
 def family_world(name: str) -> dict[str, Any]:
@@ -72,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
         world = family_world(name)
         base = None
         for label, layout in LAYOUTS.items():
-            decisions_per_second({**world, **layout}, args.worlds, 0.1)  # warm-up, compiles
+            warm_up({**world, **layout})
             rate = decisions_per_second({**world, **layout}, args.worlds, args.seconds)
             base = base or rate
             rows.append({"family": name, "layout": label, "decisions_per_s": rate})
