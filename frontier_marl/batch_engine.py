@@ -184,11 +184,10 @@ class BatchMDP:
         return batch.reshape(*shape, *batch.shape[1:])
 
     def _beliefs(self, worlds: np.ndarray | slice) -> np.ndarray | None:
-        """Every robot's belief map (its world's), robots of ``worlds`` world after world, for
-        the ``unknown_near`` feature."""
+        """The shared belief maps of ``worlds``, for the ``unknown_near`` feature."""
         if not self.cfg.observation.unknown_near:
             return None
-        return np.repeat(self.worlds.belief[worlds], self.n_agents, axis=0)
+        return self.worlds.belief[worlds]
 
     def _teammates(self, worlds: np.ndarray | slice) -> np.ndarray | None:
         layout = self.cfg.observation.teammates

@@ -221,11 +221,11 @@ class ExplorationMDP:
         return list(batch)
 
     def _beliefs(self) -> np.ndarray | None:
-        """Every robot's belief map (the shared one), for the ``unknown_near`` feature."""
+        """The robots' shared belief map, (1, H, W), for the ``unknown_near`` feature."""
         if not self.cfg.observation.unknown_near:
             return None
         assert self.world is not None
-        return np.broadcast_to(self.world.belief, (self.cfg.n_agents, *self.world.belief.shape))
+        return self.world.belief[None]
 
     def _heading(self, targets: np.ndarray | None, reached: np.ndarray | None) -> np.ndarray:
         """(N, 2) the cells the robots are heading to: the step's targets not reached yet

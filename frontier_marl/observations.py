@@ -149,7 +149,8 @@ class ObservationEncoder:
         ``positions`` (M, 2), ``teammates`` (M, (N-1) x 2 or 4) flattened per robot,
         ``heading`` (M, 2) the cells they head to (row -1: none; default none), ``motion``
         (M, 2) their displacements over their last steps (default: none), ``beliefs``
-        (M, H, W) the belief map each robot acts on (needed by ``unknown_near``). Returns the
+        (B, H, W) the shared belief maps of the B worlds the robots act in, world after world
+        (needed by ``unknown_near``). Returns the
         ``(M, ...)`` array, or a dict of them, in :attr:`space`'s layout."""
         if self.features == "explorer":
             if heading is None:

@@ -192,19 +192,23 @@ def unknown_tables(beliefs: np.ndarray) -> np.ndarray:
 
 
 def unknown_near(slots: SlotArrays, beliefs: np.ndarray, near: int = NEAR) -> np.ndarray:
-    """(M, n_slots, 1) :data:`UNKNOWN_NEAR_FEATURE` of M robots whose beliefs are ``beliefs``
-    (M, H, W) (0 on padding slots); ``near``: the square's half-side in cells."""
-    count, height, width = beliefs.shape
-    table = unknown_tables(beliefs)
+    """(M, n_slots, 1) :data:`UNKNOWN_NEAR_FEATURE` of M robots (0 on padding slots):
+    ``beliefs`` (B, H, W) are the B worlds' shared beliefs, the robots world after world (M / B
+    robots each); ``near``: the square's half-side in cells."""
+    worlds, height, width = beliefs.shape
+    count = slots.valid.shape[0]
+    if count % worlds:
+        raise ValueError(f"{count} robots cannot share {worlds} belief maps evenly")
+    table = unknown_tables(beliefs)  # one per world, not per robot
     rows, cols = slots.target[..., 0], slots.target[..., 1]
     top, bottom = np.clip(rows - near, 0, height), np.clip(rows + near + 1, 0, height)
     left, right = np.clip(cols - near, 0, width), np.clip(cols + near + 1, 0, width)
-    robots = np.arange(count)[:, None]
+    world = (np.arange(count) // (count // worlds))[:, None]
     unknown = (
-        table[robots, bottom, right]
-        - table[robots, top, right]
-        - table[robots, bottom, left]
-        + table[robots, top, left]
+        table[world, bottom, right]
+        - table[world, top, right]
+        - table[world, bottom, left]
+        + table[world, top, left]
     )
     fraction = np.where(slots.valid, unknown / (2 * near + 1) ** 2, 0.0)
     return fraction.astype(np.float32)[..., None]

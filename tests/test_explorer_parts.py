@@ -140,6 +140,21 @@ def test_unknown_near_on_a_hand_made_belief() -> None:
     assert near[0, :, 0].tolist() == pytest.approx(expected)
 
 
+def test_unknown_near_reads_each_worlds_shared_belief_for_its_robots() -> None:
+    from frontier_marl.core.grid import FREE, UNKNOWN
+
+    first = np.full((30, 30), FREE, dtype=np.int8)
+    second = np.full((30, 30), UNKNOWN, dtype=np.int8)
+    tables = [_table([(15, 15)], [1], n_slots=2), _table([(0, 0)], [2], n_slots=2)]
+    robots = SlotArrays.stack(tables * 2)  # two worlds of two robots, world after world
+    shared = unknown_near(robots, np.stack([first, second]))[..., 0]
+    alone = unknown_near(robots, np.stack([first, first, second, second]))[..., 0]
+    assert np.array_equal(shared, alone)
+    assert shared[:2, 0].tolist() == [0.0, 0.0] and shared[2, 0] == 1.0
+    with pytest.raises(ValueError, match="3 robots cannot share 2 belief maps"):
+        unknown_near(SlotArrays.stack(tables + tables[:1]), np.stack([first, second]))
+
+
 def test_unknown_tables_match_numpys_summed_area_tables() -> None:
     from frontier_marl.core.grid import UNKNOWN
     from frontier_marl.slot_features import unknown_tables
