@@ -68,6 +68,8 @@ class ObservationConfig:
         unknown_near: with ``features="explorer"``, one more feature per slot: the unknown
             fraction of the 25 x 25 square around the slot's target
             (:func:`frontier_marl.slot_features.unknown_near`).
+        near_ranges: the unknown_near square's half-side in sensor ranges (rounded, at least
+            one cell); ``None`` keeps the fixed 12 cells, whatever the sensor.
         fill: with ``features="explorer"``, one more feature per slot: the cluster's size over
             ``max_cluster_cells`` (:func:`frontier_marl.slot_features.cluster_fill`).
     """
@@ -84,6 +86,7 @@ class ObservationConfig:
     tour: bool = False
     turn: bool = False
     unknown_near: bool = False
+    near_ranges: float | None = None
     fill: bool = False
 
     def validate(self) -> None:
@@ -107,6 +110,12 @@ class ObservationConfig:
             if getattr(self, name) and self.features != "explorer":
                 raise ValueError(
                     f"{name}=True needs features='explorer' (it is a per-slot feature)"
+                )
+        if self.near_ranges is not None:
+            check_range("near_ranges", self.near_ranges, 0.0, 50.0, low_open=True)
+            if not self.unknown_near:
+                raise ValueError(
+                    "near_ranges sizes the unknown_near square: it needs unknown_near=True"
                 )
         if self.centroid == "none" and not self.info_gain:
             raise ValueError(

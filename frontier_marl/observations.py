@@ -31,6 +31,7 @@ from frontier_marl.slot_features import (
     cluster_fill,
     explorer_features,
     explorer_space,
+    near_half_side,
     slot_feature_names,
     team_features,
     tour_lengths,
@@ -57,6 +58,7 @@ class ObservationEncoder:
         if self.features == "explorer":
             self.tour, self.turn, self.unknown_near = obs.tour, obs.turn, obs.unknown_near
             self.fill = obs.fill
+            self.near = near_half_side(obs.near_ranges, cfg.perception_range)
             self.features_per_slot = len(slot_feature_names(obs))
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
             return
@@ -166,7 +168,9 @@ class ObservationEncoder:
             if self.unknown_near:
                 if beliefs is None:
                     raise ValueError("the unknown_near feature needs the robots' belief maps")
-                features = np.concatenate([features, unknown_near(slots, beliefs)], axis=-1)
+                features = np.concatenate(
+                    [features, unknown_near(slots, beliefs, self.near)], axis=-1
+                )
             if self.fill:
                 fill = cluster_fill(slots, self.cfg.max_cluster_cells)
                 features = np.concatenate([features, fill], axis=-1)
@@ -243,6 +247,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "tour": cfg.observation.tour,
             "turn": cfg.observation.turn,
             "unknown_near": cfg.observation.unknown_near,
+            "near_ranges": cfg.observation.near_ranges,
             "fill": cfg.observation.fill,
             "n_agents": None,
             "n_slots": enc.n_slots,

@@ -31,7 +31,8 @@ With ``turn=True``, one more (:data:`TURN_FEATURE`), after those:
 With ``unknown_near=True``, one more (:data:`UNKNOWN_NEAR_FEATURE`), after those:
 
 ``unknown_near``  the unknown cells of the belief in the square of side ``2 * NEAR + 1``
-                  (:data:`NEAR` = 12 cells) centred on the slot's target, as a fraction of
+                  (:data:`NEAR` = 12 cells, or ``near_ranges`` sensor ranges:
+                  :func:`near_half_side`) centred on the slot's target, as a fraction of
                   the square's cells (:func:`unknown_near`); cells beyond the map count as
                   known, so a frontier hemmed in by the map's edge or by known walls scores
                   low, one that opens onto a large unexplored region high
@@ -141,26 +142,41 @@ def tour_lengths(slots: SlotArrays) -> np.ndarray:
     """(M, n_slots, 1) :data:`TOUR_FEATURE` of M robots, in :data:`CELLS` units (0 on padding
     slots): from each live slot's target, the greedy nearest-neighbour tour (Euclidean,
     ties to the lower slot) through the targets of every other live slot."""
-    valid = slots.valid
-    count, n_slots = valid.shape
-    target = slots.target.astype(np.float64)
-    apart = np.linalg.norm(target[:, :, None, :] - target[:, None, :, :], axis=-1)
-    apart = np.where(valid[:, None, :], apart, np.inf)  # (M, S, S): never to a padding slot
-    robots = np.arange(count)[:, None]
-    starts = np.arange(n_slots)[None, :]
-    at = np.broadcast_to(starts, (count, n_slots)).copy()  # each tour's current slot
-    visited = ~valid[:, None, :] | (np.arange(n_slots)[None, None, :] == at[..., None])
-    length = np.zeros((count, n_slots))
-    for _ in range(n_slots - 1):
-        step = np.where(visited, np.inf, apart[robots, at])  # (M, S starts, S next)
-        nearest = step.argmin(axis=2)
-        gap = np.take_along_axis(step, nearest[..., None], axis=2)[..., 0]
-        going = np.isfinite(gap)
-        length += np.where(going, gap, 0.0)
-        at = np.where(going, nearest, at)
-        visited |= going[..., None] & (np.arange(n_slots)[None, None, :] == nearest[..., None])
-    length[~valid] = 0.0
+    length = _tours(slots.target.astype(np.float64), slots.valid)
     return (length / CELLS).astype(np.float32)[..., None]
+
+
+@compiled
+def _tours(target: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """(M, S) nearest-neighbour tour lengths in cells from each live slot of M robots; ``target``
+    (M, S, 2) float, ``valid`` (M, S) bool."""
+    count, n_slots = valid.shape
+    length = np.zeros((count, n_slots))
+    visited = np.zeros(n_slots, dtype=np.bool_)
+    for m in range(count):
+        for start in range(n_slots):
+            if not valid[m, start]:
+                continue
+            for s in range(n_slots):
+                visited[s] = not valid[m, s]
+            visited[start] = True
+            at, total = start, 0.0
+            while True:
+                nearest, best = -1, np.inf
+                for s in range(n_slots):
+                    if not visited[s]:
+                        d_row = target[m, at, 0] - target[m, s, 0]
+                        d_col = target[m, at, 1] - target[m, s, 1]
+                        gap = np.sqrt(d_row * d_row + d_col * d_col)
+                        if gap < best:  # strict: ties go to the lower slot
+                            nearest, best = s, gap
+                if nearest < 0:
+                    break
+                total += best
+                visited[nearest] = True
+                at = nearest
+            length[m, start] = total
+    return length
 
 
 def turn_costs(slots: SlotArrays, positions: np.ndarray, motion: np.ndarray) -> np.ndarray:
@@ -189,6 +205,12 @@ def unknown_tables(beliefs: np.ndarray) -> np.ndarray:
                 row += beliefs[m, r, c] == UNKNOWN
                 table[m, r + 1, c + 1] = table[m, r, c + 1] + row
     return table
+
+
+def near_half_side(near_ranges: float | None, perception_range: int) -> int:
+    """unknown_near's half-side in cells: :data:`NEAR` (``near_ranges`` None), else
+    ``near_ranges`` sensor ranges, rounded, at least one cell."""
+    return NEAR if near_ranges is None else max(1, round(near_ranges * perception_range))
 
 
 def unknown_near(slots: SlotArrays, beliefs: np.ndarray, near: int = NEAR) -> np.ndarray:

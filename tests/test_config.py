@@ -76,6 +76,7 @@ BAD_VALUES = [
     ("turn", 1, "turn"),
     ("unknown_near", "yes", "unknown_near"),
     ("fill", 1, "fill"),
+    ("near_ranges", -1.0, "near_ranges"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),
     ("explore_threshold", 1.01, "explore_threshold"),

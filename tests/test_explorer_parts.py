@@ -67,6 +67,31 @@ def test_tour_lengths_on_a_hand_made_table() -> None:
     assert not tours[1].any()  # a single live slot has nowhere else to go
 
 
+def _reference_tour(targets: list[tuple[int, int]], start: int) -> float:
+    """The nearest-neighbour tour from ``start`` through ``targets``, the plain way."""
+    left, at, total = [i for i in range(len(targets)) if i != start], start, 0.0
+    while left:
+        gaps = [float(np.hypot(*np.subtract(targets[at], targets[i]))) for i in left]
+        at = left[int(np.argmin(gaps))]  # the first of equal gaps: the lower slot
+        total += min(gaps)
+        left.remove(at)
+    return total
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_tour_lengths_match_the_plain_tour_on_random_tables(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    tables, expected = [], []
+    for _ in range(5):
+        live = int(rng.integers(0, 7))
+        targets = [tuple(int(v) for v in rng.integers(0, 6, 2)) for _ in range(live)]  # ties
+        tables.append(_table(targets, [1] * live, n_slots=6))
+        tours = [_reference_tour(targets, start) / CELLS for start in range(live)]
+        expected.append(tours + [0.0] * (6 - live))
+    tours = tour_lengths(SlotArrays.stack(tables))[..., 0]
+    assert np.allclose(tours, expected, rtol=1e-6)
+
+
 def test_the_tour_feature_extends_the_explorer_layout_and_needs_it() -> None:
     env = frontier_marl.parallel_env(**EXPLORER, tour=True)
     observations, _ = env.reset(seed=3)
