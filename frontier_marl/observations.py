@@ -157,29 +157,26 @@ class ObservationEncoder:
         if self.features == "explorer":
             if heading is None:
                 heading = np.full_like(positions, -1)
-            features = explorer_features(slots, positions, heading)
+            parts = [explorer_features(slots, positions, heading)]
             if self.tour:
-                features = np.concatenate([features, tour_lengths(slots)], axis=-1)
+                parts.append(tour_lengths(slots))
             if self.turn:
                 if motion is None:
                     motion = np.zeros_like(positions)
-                turn = turn_costs(slots, positions, motion)
-                features = np.concatenate([features, turn], axis=-1)
+                parts.append(turn_costs(slots, positions, motion))
             if self.unknown_near:
                 if beliefs is None:
                     raise ValueError("the unknown_near feature needs the robots' belief maps")
-                features = np.concatenate(
-                    [features, unknown_near(slots, beliefs, self.near)], axis=-1
-                )
+                parts.append(unknown_near(slots, beliefs, self.near))
             if self.fill:
-                fill = cluster_fill(slots, self.cfg.max_cluster_cells)
-                features = np.concatenate([features, fill], axis=-1)
+                parts.append(cluster_fill(slots, self.cfg.max_cluster_cells))
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
                 width = 4 if self.teammates == "positions+targets" else 2
                 rows = np.asarray(teammates, dtype=np.float64).reshape(len(positions), -1, width)
-                features = np.concatenate([features, team_features(slots, rows)], axis=-1)
+                parts.append(team_features(slots, rows))
+            features = np.concatenate(parts, axis=-1)  # one copy, not one per feature
             return {"slots": features, "action_mask": np.array(slots.mask, dtype=np.int8)}
         dtype = np.float64 if self.normalize else np.float32  # normalize in float64
         count = len(positions)
