@@ -17,7 +17,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "benchmark",
         "exploration efficiency (T99, T90, success) of policies on map families",
     ),
-    "train": ("train", "train DQN on an experiment config (SB3 through SuperSuit)"),
+    "train": ("train", "train an experiment config (DQN, PPO, MaskablePPO or CEM)"),
     "evaluate": ("evaluate", "evaluate a trained model with the thesis's protocol"),
     "reproduce": (
         "reproduce",

@@ -1,4 +1,5 @@
-"""``frontier-marl train``: train DQN on one experiment config (SB3 on the batched vector env).
+"""``frontier-marl train``: train one experiment config (SB3's DQN or PPO, sb3-contrib's
+MaskablePPO, or the cross-entropy method, by ``train.algorithm``) on the batched vector env.
 
 Examples::
 
@@ -6,9 +7,10 @@ Examples::
     frontier-marl train config04 --steps 50000 --seed 1        # a name under training/ works too
     frontier-marl train config01 --set dqn.learning_rate=1e-4 --set env.map_mode=dynamic
     frontier-marl train --resume runs/config01/seed0           # continue (or extend with --steps)
+    frontier-marl train explorer-ppo --steps 20000             # MaskablePPO on the slot scorer
 
 The run folder (default ``runs/<name>/seed<seed>``) gets the model and its metadata, TensorBoard
-logs (``tensorboard --logdir RUN/tb``), checkpoints with the replay buffer, and at the end a
+logs (``tensorboard --logdir RUN/tb``), checkpoints (with DQN's replay buffer), and at the end a
 30-episode deterministic evaluation beside greedy-distance (``evaluation.json``), an action
 histogram and a learning curve. Ctrl-C saves a checkpoint; ``--resume`` continues from it.
 """
@@ -102,7 +104,7 @@ def _resumed(args: argparse.Namespace) -> tuple[Any, Path, Any]:
         if section != "train":
             raise ValueError(
                 f"--set {text!r}: {section} settings cannot change when resuming "
-                "(the checkpoint fixes the env and the DQN)"
+                "(the checkpoint fixes the env and the algorithm's settings)"
             )
         train_overrides[key] = value
     if args.steps is not None:

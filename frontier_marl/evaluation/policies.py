@@ -19,6 +19,7 @@ Learned models plug in through :class:`CallablePolicy` (any ``obs -> action`` ca
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -144,7 +145,9 @@ class CallablePolicy(Policy):
 
 
 class ModelPolicy(Policy):
-    """Wraps a model with SB3's ``predict(obs, deterministic=...) -> (action, state)``."""
+    """Wraps a model with SB3's ``predict(obs, deterministic=...) -> (action, state)``; a
+    model whose ``predict`` takes ``action_masks`` (sb3-contrib's ``MaskablePPO``) gets the
+    env's action mask (``info["action_mask"]``)."""
 
     def __init__(self, model: Any, name: str = "model", deterministic: bool = True) -> None:
         if not hasattr(model, "predict"):
@@ -152,9 +155,13 @@ class ModelPolicy(Policy):
         self.model = model
         self.name = name
         self.deterministic = deterministic
+        self.takes_masks = "action_masks" in inspect.signature(model.predict).parameters
 
     def act(self, obs: Any, info: Info) -> int:
-        action, _ = self.model.predict(obs, deterministic=self.deterministic)
+        masks = {}
+        if self.takes_masks and "action_mask" in info:
+            masks["action_masks"] = np.asarray(info["action_mask"], dtype=bool)
+        action, _ = self.model.predict(obs, deterministic=self.deterministic, **masks)
         return _as_slot(action)
 
 

@@ -73,7 +73,8 @@ class ProgressBar(BaseCallback):
         self._shown = steps
         self._next = steps + self.every
         episodes = self.model.ep_info_buffer
-        postfix = {"eps": f"{self.model.exploration_rate:.2f}"}
+        rate = getattr(self.model, "exploration_rate", None)  # DQN's epsilon; PPO has none
+        postfix = {} if rate is None else {"eps": f"{rate:.2f}"}
         if episodes:
             postfix["ep_rew"] = f"{sum(e['r'] for e in episodes) / len(episodes):.2f}"
         self.pbar.set_postfix(postfix, refresh=False)

@@ -48,8 +48,8 @@ class Checkpoint:
 def save_checkpoint(
     model: Any, run_dir: Path, meta: dict[str, Any], keep: int = 2, replay_buffer: bool = True
 ) -> Checkpoint:
-    """Save ``model`` (+ replay buffer and ``meta``) at its current step; keep the newest
-    ``keep`` checkpoints (0 keeps all)."""
+    """Save ``model`` (+ its replay buffer, if it has one, and ``meta``) at its current step;
+    keep the newest ``keep`` checkpoints (0 keeps all)."""
     folder = Path(run_dir) / CHECKPOINTS
     folder.mkdir(parents=True, exist_ok=True)
     final = folder / f"step_{int(model.num_timesteps):09d}"
@@ -59,7 +59,7 @@ def save_checkpoint(
     tmp.mkdir()
     model.save(tmp / MODEL_FILE)
     save_metadata(meta, tmp / "model.json")
-    if replay_buffer:
+    if replay_buffer and hasattr(model, "save_replay_buffer"):
         model.save_replay_buffer(tmp / BUFFER_FILE)
     if final.exists():
         shutil.rmtree(final)

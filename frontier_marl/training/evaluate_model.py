@@ -65,12 +65,14 @@ def resolve_model_path(path: str | Path) -> Path:
 
 
 def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
-    """Load an SB3 DQN model and its metadata."""
-    from stable_baselines3 import DQN
+    """Load an SB3 model (DQN, PPO or MaskablePPO, by its metadata) and its metadata."""
+    from frontier_marl.training.algorithms import loader
 
     model_path = resolve_model_path(path)
-    model = DQN.load(model_path, device=device)
-    return LoadedModel(model=model, path=model_path, metadata=load_metadata(model_path))
+    metadata = load_metadata(model_path)
+    algorithm = loader(None if metadata is None else metadata.get("algorithm"))
+    model = algorithm.load(model_path, device=device)
+    return LoadedModel(model=model, path=model_path, metadata=metadata)
 
 
 def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:

@@ -17,17 +17,19 @@ A config file has four parts (every one optional except ``name``)::
     seed = 0
 
 and, with ``train.algorithm = "cem"``, a ``[cem]`` section instead of ``[dqn]``
-(:class:`~frontier_marl.training.cem.CEMSettings`).
+(:class:`~frontier_marl.training.cem.CEMSettings`); with ``"ppo"`` or ``"maskable-ppo"``, a
+``[ppo]`` section (keyword arguments of SB3's ``PPO`` or sb3-contrib's ``MaskablePPO``, their
+defaults where unset) and no ``[dqn]``.
 
 Overrides use ``section.key=value`` (``env.reward=reward1``, ``dqn.learning_rate=1e-4``,
-``train.n_envs=2``); a bare ``key=value`` goes to the one section that knows the key. Values
+``train.n_envs=2``); a bare ``key=value`` goes to the one section that knows the key (a
+keyword that DQN and PPO share goes to ``[dqn]``: write ``ppo.key=value``). Values
 are parsed as TOML (``1e-4``, ``true``, ``[64, 64]``), else kept as strings.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 import tomllib
 from collections.abc import Iterable, Mapping
@@ -39,32 +41,21 @@ from typing import Any
 from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.thesis import DQN_HYPERPARAMETERS
+from frontier_marl.training.algorithms import SECTION, keyword_names
 from frontier_marl.training.cem import CEM_KEYS, CEMSettings
 from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
 
 __all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
 
-SECTIONS = ("env", "dqn", "train", "cem")
+SECTIONS = ("env", "dqn", "ppo", "train", "cem")
 
 #: The thesis's final DQN hyperparameters; everything else is SB3's default.
 THESIS_DQN = DQN_HYPERPARAMETERS
 
-#: DQN arguments the pipeline sets itself (seeding goes through set_random_seed: SuperSuit's
-#: vector env cannot be seeded by SB3, see frontier_marl.training.vec_env).
-_RESERVED_DQN = {
-    "policy",
-    "env",
-    "seed",
-    "device",
-    "tensorboard_log",
-    "verbose",
-    "_init_setup_model",
-}
-
 
 @dataclass(frozen=True)
 class Experiment:
-    """One training experiment: env keywords, DQN keywords, and run settings."""
+    """One training experiment: env keywords, the algorithm's keywords, and run settings."""
 
     name: str
     description: str = ""
@@ -72,7 +63,12 @@ class Experiment:
     dqn: dict[str, Any] = field(default_factory=lambda: dict(THESIS_DQN))
     train: TrainSettings = field(default_factory=TrainSettings)
     cem: dict[str, Any] = field(default_factory=dict)
+    ppo: dict[str, Any] = field(default_factory=dict)
     source: str | None = None
+
+    def hyperparameters(self) -> dict[str, Any]:
+        """The keyword arguments of ``train.algorithm``'s SB3 class (``[dqn]`` or ``[ppo]``)."""
+        return self.ppo if self._uses_ppo() else self.dqn
 
     def env_config(self) -> EnvConfig:
         """The validated env config (raises ``ValueError`` naming a bad env key); with
@@ -100,7 +96,7 @@ class Experiment:
             "name": self.name,
             "description": self.description,
             "env": dict(self.env),
-            "dqn": dict(self.dqn),
+            **({"ppo": dict(self.ppo)} if self._uses_ppo() else {"dqn": dict(self.dqn)}),
             "train": {
                 **dataclasses.asdict(self.train),
                 "families": list(self.train.families),
@@ -109,12 +105,13 @@ class Experiment:
             **({"cem": dict(self.cem)} if self.cem else {}),
         }
 
+    def _uses_ppo(self) -> bool:
+        return SECTION.get(self.train.algorithm) == "ppo"
+
 
 def dqn_keys() -> set[str]:
     """Keyword arguments of ``stable_baselines3.DQN`` that a config may set."""
-    from stable_baselines3 import DQN
-
-    return set(inspect.signature(DQN.__init__).parameters) - {"self"} - _RESERVED_DQN
+    return keyword_names("dqn")
 
 
 def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> Experiment:
@@ -124,7 +121,7 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     if unknown:
         raise ValueError(
             f"unknown top-level key(s) {sorted(unknown)}{where}; "
-            "allowed: name, description, [env], [dqn], [train], [cem]"
+            "allowed: name, description, [env], [dqn], [ppo], [train], [cem]"
         )
     name = data.get("name")
     if not isinstance(name, str) or not name:
@@ -152,7 +149,18 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
             f"unknown or reserved [dqn] key(s) {sorted(bad_dqn)}{where}; "
             f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
         )
-    _check_dqn(dqn, where)
+    _check_ranges("dqn", dqn, where)
+    settings = TrainSettings(**train_kw)
+    ppo = dict(data.get("ppo", {}))
+    _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
+    if ppo:
+        bad_ppo = set(ppo) - keyword_names(settings.algorithm)
+        if bad_ppo:
+            raise ValueError(
+                f"unknown or reserved [ppo] key(s) {sorted(bad_ppo)}{where}; allowed: "
+                f"{sorted(keyword_names(settings.algorithm))} (seed and device are set in [train])"
+            )
+        _check_ranges("ppo", ppo, where)
     cem = dict(data.get("cem", {}))
     bad_cem = set(cem) - CEM_KEYS
     if bad_cem:
@@ -167,8 +175,9 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         description=str(data.get("description", "")),
         env=env,
         dqn=dqn,
-        train=TrainSettings(**train_kw),
+        train=settings,
         cem=cem,
+        ppo=ppo,
         source=source,
     )
     try:
@@ -178,7 +187,23 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     return experiment
 
 
-#: Ranges of the DQN settings checked before SB3 sees them: key -> (kind, low, high).
+def _check_sections(algorithm: str, has_dqn: bool, has_ppo: bool, where: str) -> None:
+    """A ``[dqn]`` or ``[ppo]`` section that ``algorithm`` would not read is an error (it
+    would be silently ignored)."""
+    section = SECTION.get(algorithm)
+    if has_ppo and section != "ppo":
+        raise ValueError(
+            f"[ppo] settings{where} are read only with train.algorithm = 'ppo' or "
+            f"'maskable-ppo' (it is {algorithm!r})"
+        )
+    if has_dqn and section == "ppo":
+        raise ValueError(
+            f"[dqn] settings{where} are not read with train.algorithm = {algorithm!r}: "
+            "set PPO's keywords in [ppo] (ppo.key=value)"
+        )
+
+
+#: Ranges of the settings checked before SB3 sees them: section -> key -> (kind, low, high).
 _DQN_RANGES: dict[str, tuple[str, float, float]] = {
     "learning_rate": ("float", 0.0, math.inf),
     "exploration_fraction": ("float", 0.0, 1.0),
@@ -197,11 +222,26 @@ _DQN_RANGES: dict[str, tuple[str, float, float]] = {
 }
 
 
-def _check_dqn(dqn: Mapping[str, Any], where: str) -> None:
-    for key, (kind, low, high) in _DQN_RANGES.items():
-        if key not in dqn:
+_PPO_RANGES: dict[str, tuple[str, float, float]] = {
+    "learning_rate": ("float", 0.0, math.inf),
+    "n_steps": ("int", 1, math.inf),
+    "batch_size": ("int", 1, math.inf),
+    "n_epochs": ("int", 1, math.inf),
+    "gamma": ("float", 0.0, 1.0),
+    "gae_lambda": ("float", 0.0, 1.0),
+    "clip_range": ("float", 0.0, math.inf),
+    "ent_coef": ("float", 0.0, math.inf),
+    "vf_coef": ("float", 0.0, math.inf),
+    "max_grad_norm": ("float", 0.0, math.inf),
+}
+_RANGES = {"dqn": _DQN_RANGES, "ppo": _PPO_RANGES}
+
+
+def _check_ranges(section: str, values: Mapping[str, Any], where: str) -> None:
+    for key, (kind, low, high) in _RANGES[section].items():
+        if key not in values:
             continue
-        value = dqn[key]
+        value = values[key]
         if kind == "int":
             ok = isinstance(value, int) and not isinstance(value, bool)
             if key == "train_freq" and isinstance(value, list | tuple) and len(value) == 2:
@@ -213,11 +253,13 @@ def _check_dqn(dqn: Mapping[str, Any], where: str) -> None:
             what = "a number"
         if not ok or not low <= value <= high:
             bounds = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
-            raise ValueError(f"dqn.{key} must be {what} {bounds}, got {dqn[key]!r}{where}")
-    if dqn.get("learning_rate", 1.0) == 0:
-        raise ValueError(f"dqn.learning_rate must be > 0{where}")
-    if dqn.get("gradient_steps", 1) == 0:
-        raise ValueError(f"dqn.gradient_steps must be >= 1 or -1, got 0{where}")
+            raise ValueError(f"{section}.{key} must be {what} {bounds}, got {values[key]!r}{where}")
+    if values.get("learning_rate", 1.0) == 0:
+        raise ValueError(f"{section}.learning_rate must be > 0{where}")
+    if values.get("gradient_steps", 1) == 0:
+        raise ValueError(f"{section}.gradient_steps must be >= 1 or -1, got 0{where}")
+    if values.get("clip_range", 1.0) == 0:
+        raise ValueError(f"{section}.clip_range must be > 0{where}")
 
 
 def parse_override(text: str) -> tuple[str, str, Any]:
@@ -231,7 +273,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
         section, name = key.split(".", 1)
         if section not in SECTIONS:
             raise ValueError(
-                f"override section must be env, dqn, train or cem, got {section!r} in {text!r}"
+                f"override section must be env, dqn, ppo, train or cem, got {section!r} in {text!r}"
             )
         return section, name, value
     owners = [
@@ -239,6 +281,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
         for section, keys in (
             ("train", TRAIN_KEYS),
             ("dqn", dqn_keys()),
+            ("ppo", keyword_names("ppo") - dqn_keys()),
             ("cem", CEM_KEYS),
             ("env", set(config_keys())),
         )
@@ -246,7 +289,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
     ]
     if not owners:
         raise ValueError(
-            f"unknown override key {key!r}: not an env, dqn or train key "
+            f"unknown override key {key!r}: not an env, dqn, ppo, train or cem key "
             "(use section.key=value to be explicit)"
         )
     if len(owners) > 1:

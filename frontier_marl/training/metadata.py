@@ -49,6 +49,7 @@ def build_metadata(
     *,
     policy: str,
     num_timesteps: int,
+    algorithm: str = "DQN",
     experiment: dict[str, Any] | None = None,
     extra: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
@@ -61,7 +62,7 @@ def build_metadata(
 
     return {
         "format": METADATA_FORMAT,
-        "algorithm": "DQN",
+        "algorithm": algorithm,
         "policy": policy,
         "num_timesteps": int(num_timesteps),
         "env_config": config_to_dict(cfg),

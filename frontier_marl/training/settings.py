@@ -8,7 +8,7 @@ from dataclasses import dataclass
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
 POLICIES = ("auto", "slot-scorer")
-ALGORITHMS = ("dqn", "cem")
+ALGORITHMS = ("dqn", "ppo", "maskable-ppo", "cem")
 
 
 @dataclass(frozen=True)
@@ -44,9 +44,10 @@ class TrainSettings:
         validation_seed: first reset seed of the validation episodes; the range must not
             overlap the evaluation's (``eval_seed`` .. ``eval_seed + eval_episodes - 1``).
         policy: ``auto`` (SB3's ``MlpPolicy`` or ``MultiInputPolicy``, by observation) or
-            ``slot-scorer`` (the masked, permutation-equivariant Q-network of
-            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; needs
-            ``features = "explorer"``).
+            ``slot-scorer`` (the masked, permutation-equivariant slot scorer; needs
+            ``features = "explorer"``): with DQN the Q-network of
+            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; with PPO the
+            actor-critic of :mod:`frontier_marl.training.slot_actor_critic`.
         families: benchmark map families to train on (:mod:`frontier_marl.evaluation.families`),
             ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
             range; ``[env]`` then sets the observation and reward (not the map). Empty: the
@@ -58,10 +59,12 @@ class TrainSettings:
             single valid slot (a commitment, one cluster left) are played by the batched env
             and their rewards summed into the decision's transition (a semi-MDP; ``gamma``
             then discounts per decision). ``total_timesteps`` counts decisions.
-        algorithm: ``dqn`` (SB3 DQN with ``[dqn]``) or ``cem``: the cross-entropy method on a
-            linear slot scorer with ``[cem]`` (:mod:`frontier_marl.training.cem`; one robot,
-            ``families`` and the explorer features needed; ``total_timesteps``, checkpoints
-            and ``[dqn]`` unused).
+        algorithm: ``dqn`` (SB3 DQN with ``[dqn]``), ``ppo`` (SB3 PPO with ``[ppo]``),
+            ``maskable-ppo`` (sb3-contrib's MaskablePPO with ``[ppo]``: the env's action masks
+            applied to the policy; needs the batched vector env) or ``cem``: the
+            cross-entropy method on a linear slot scorer with ``[cem]``
+            (:mod:`frontier_marl.training.cem`; one robot, ``families`` and the explorer
+            features needed; ``total_timesteps``, checkpoints and ``[dqn]`` unused).
     """
 
     total_timesteps: int = 1_000_000
@@ -110,6 +113,8 @@ class TrainSettings:
             )
         if self.algorithm == "cem" and (not self.families or self.agents != (1,)):
             raise ValueError("train.algorithm = 'cem' needs train.families and one robot")
+        if self.algorithm == "maskable-ppo" and self.vec_env != "batched":
+            raise ValueError("train.algorithm = 'maskable-ppo' needs train.vec_env = 'batched'")
         if self.policy not in POLICIES:
             raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
         if self.families:

@@ -28,7 +28,7 @@ from torch.nn import functional as F
 MASKED_Q = -1e9  # the Q-value of a masked slot: below any return
 
 
-def _mlp(sizes: list[int], activation: type[nn.Module]) -> nn.Sequential:
+def mlp_layers(sizes: list[int], activation: type[nn.Module]) -> nn.Sequential:
     layers: list[nn.Module] = []
     for size_in, size_out in zip(sizes[:-1], sizes[1:], strict=True):
         layers += [nn.Linear(size_in, size_out), activation()]
@@ -39,7 +39,11 @@ class SlotExtractor(BaseFeaturesExtractor):
     """Passes the slot features and the mask through, flattened: ``(B, S * F + S)``."""
 
     def __init__(self, observation_space: spaces.Dict) -> None:
-        slots = observation_space["slots"]
+        slots = (
+            observation_space.spaces.get("slots")
+            if isinstance(observation_space, spaces.Dict)
+            else None
+        )
         if not isinstance(slots, spaces.Box) or len(slots.shape) != 2:
             raise ValueError("the slot scorer needs the explorer observation (features='explorer')")
         self.n_slots, self.n_features = slots.shape
@@ -54,6 +58,17 @@ def split_slots(flat: th.Tensor, n_slots: int, n_features: int) -> tuple[th.Tens
     """``(B, S * F + S)`` (features, then mask) -> features ``(B, S, F)`` and mask ``(B, S)``."""
     slots = flat[:, : n_slots * n_features].reshape(-1, n_slots, n_features)
     return slots, flat[:, n_slots * n_features :] > 0.5
+
+
+def pool_live(encoded: th.Tensor, mask: th.Tensor) -> tuple[th.Tensor, th.Tensor, th.Tensor]:
+    """Mean and max of the live slots' encodings ``(B, S, H)`` -> pooled ``(B, 2H)`` (zeros
+    for a row without a live slot), the live mask ``(B, S, 1)`` and the live count ``(B, 1)``."""
+    live = mask.unsqueeze(-1)
+    count = live.sum(dim=1).clamp(min=1)
+    mean = (encoded * live).sum(dim=1) / count
+    top = encoded.masked_fill(~live, -th.inf).max(dim=1).values
+    top = th.where(th.isfinite(top), top, th.zeros_like(top))
+    return th.cat([mean, top], dim=1), live, count
 
 
 class SlotScorer(nn.Module):
@@ -81,14 +96,16 @@ class SlotScorer(nn.Module):
                 f"attention_heads must be >= 0 and divide the last hidden size {width}, "
                 f"got {attention_heads}"
             )
-        self.encode = _mlp([n_features, *hidden], activation)
+        self.encode = mlp_layers([n_features, *hidden], activation)
         self.attend = (
             nn.MultiheadAttention(width, attention_heads, batch_first=True)
             if attention_heads
             else None
         )
-        self.score = nn.Sequential(_mlp([3 * width, *hidden], activation), nn.Linear(width, 1))
-        self.value = nn.Sequential(_mlp([2 * width, width], activation), nn.Linear(width, 1))
+        self.score = nn.Sequential(
+            mlp_layers([3 * width, *hidden], activation), nn.Linear(width, 1)
+        )
+        self.value = nn.Sequential(mlp_layers([2 * width, width], activation), nn.Linear(width, 1))
 
     def forward(self, flat: th.Tensor) -> th.Tensor:
         s = self.n_slots
@@ -99,12 +116,7 @@ class SlotScorer(nn.Module):
             ignored = ~mask & mask.any(dim=1, keepdim=True)
             attended, _ = self.attend(encoded, encoded, encoded, key_padding_mask=ignored)
             encoded = encoded + attended
-        live = mask.unsqueeze(-1)
-        count = live.sum(dim=1).clamp(min=1)
-        mean = (encoded * live).sum(dim=1) / count
-        top = encoded.masked_fill(~live, -th.inf).max(dim=1).values
-        top = th.where(th.isfinite(top), top, th.zeros_like(top))
-        pooled = th.cat([mean, top], dim=1)
+        pooled, live, count = pool_live(encoded, mask)
         context = pooled.unsqueeze(1).expand(-1, s, -1)
         advantage = self.score(th.cat([encoded, context], dim=2)).squeeze(-1)
         # dueling: a state value from the pooled context plus each slot's advantage, centred
@@ -133,6 +145,24 @@ class LinearSlotScorer(nn.Module):
 SCORERS = ("mlp", "linear")
 
 
+def make_scorer(
+    scorer: str,
+    extractor: SlotExtractor,
+    hidden: list[int],
+    activation: type[nn.Module],
+    attention_heads: int = 0,
+) -> nn.Module:
+    """The slot scorer named ``scorer`` (:data:`SCORERS`) for ``extractor``'s slots; a
+    ValueError names a bad choice."""
+    if scorer not in SCORERS:
+        raise ValueError(f"scorer must be one of {list(SCORERS)}, got {scorer!r}")
+    if scorer == "linear":
+        if attention_heads:
+            raise ValueError("attention_heads needs scorer='mlp'")
+        return LinearSlotScorer(extractor.n_slots, extractor.n_features)
+    return SlotScorer(extractor.n_slots, extractor.n_features, hidden, activation, attention_heads)
+
+
 class SlotQNetwork(QNetwork):
     """SB3's ``QNetwork`` with a slot scorer as its head: :class:`SlotScorer` (``scorer =
     "mlp"``; ``net_arch``: hidden sizes) or :class:`LinearSlotScorer` (``"linear"``)."""
@@ -143,19 +173,8 @@ class SlotQNetwork(QNetwork):
         super().__init__(*args, **kwargs)
         extractor = self.features_extractor
         assert isinstance(extractor, SlotExtractor)
-        if scorer not in SCORERS:
-            raise ValueError(f"scorer must be one of {list(SCORERS)}, got {scorer!r}")
-        if scorer == "linear":
-            if attention_heads:
-                raise ValueError("attention_heads needs scorer='mlp'")
-            self.q_net = LinearSlotScorer(extractor.n_slots, extractor.n_features)
-            return
-        self.q_net = SlotScorer(
-            extractor.n_slots,
-            extractor.n_features,
-            list(self.net_arch),
-            self.activation_fn,
-            attention_heads,
+        self.q_net = make_scorer(
+            scorer, extractor, list(self.net_arch), self.activation_fn, attention_heads
         )
 
 

@@ -9,7 +9,7 @@ Run folder::
     RUN/metrics.jsonl                every logger dump (the learning curve's data)
     RUN/tb/                          TensorBoard: rollout/ep_rew_mean, train/loss,
                                      rollout/exploration_rate
-    RUN/checkpoints/step_*/          model + replay buffer + metadata (newest ``keep`` kept)
+    RUN/checkpoints/step_*/          model + replay buffer (DQN) + metadata (newest ``keep`` kept)
     RUN/validation.jsonl, RUN/best/  with ``train.validate_every``: validation scores, and the
                                      best-validated policy with its own evaluation.json
     RUN/run.json                     the experiment and one entry per training session
@@ -34,6 +34,7 @@ import numpy as np
 
 from frontier_marl.config import make_config
 from frontier_marl.json_files import write_json
+from frontier_marl.training.algorithms import LABEL, SECTION, learner
 from frontier_marl.training.checkpoints import (
     MODEL_FILE,
     Checkpoint,
@@ -146,17 +147,6 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
     return VecMonitor(MixedVecEnv(parts))
 
 
-def learner(policy: str) -> tuple[Any, Any]:
-    """The SB3 algorithm class and policy class (None: by observation) of ``train.policy``."""
-    if policy == "slot-scorer":
-        from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
-
-        return MaskedDQN, SlotDQNPolicy
-    from stable_baselines3 import DQN
-
-    return DQN, None
-
-
 def train(
     experiment: Experiment,
     run_dir: str | Path,
@@ -199,7 +189,7 @@ def train(
     seed = session_seed(settings.seed, start_step)
     set_random_seed(seed)
     vec_env = training_vec_env(experiment, seed)
-    algorithm, policy_class = learner(settings.policy)
+    algorithm, policy_class = learner(settings.algorithm, settings.policy)
     if checkpoint is None:
         try:
             model = algorithm(
@@ -207,14 +197,17 @@ def train(
                 vec_env,
                 device=settings.device,
                 verbose=verbose,
-                **experiment.dqn,
+                **experiment.hyperparameters(),
             )
         except (TypeError, ValueError, AssertionError) as exc:
             vec_env.close()
-            raise ValueError(f"[dqn] settings rejected by stable_baselines3.DQN: {exc}") from exc
+            section = SECTION[settings.algorithm]
+            raise ValueError(
+                f"[{section}] settings rejected by {algorithm.__name__}: {exc}"
+            ) from exc
     else:
         model = algorithm.load(checkpoint.model, env=vec_env, device=settings.device)
-        if checkpoint.replay_buffer.is_file():
+        if checkpoint.replay_buffer.is_file() and hasattr(model, "load_replay_buffer"):
             model.load_replay_buffer(checkpoint.replay_buffer)
         start_step = model.num_timesteps
     model.action_space.seed(seed)
@@ -228,6 +221,7 @@ def train(
             model.observation_space,
             model.action_space,
             policy=policy,
+            algorithm=LABEL[settings.algorithm],
             num_timesteps=model.num_timesteps,
             experiment=experiment.to_dict(),
             extra={"seed": settings.seed, "session_seed": seed},

@@ -176,8 +176,8 @@ def _check_same_experiment(run_dir: Path, spec: TrialSpec) -> None:
         if not saved:
             continue
         wanted = json.loads(json.dumps(spec.experiment))
-        for key in ("env", "dqn"):
-            if json.loads(json.dumps(saved.get(key))) != wanted[key]:
+        for key in ("env", "dqn", "ppo"):
+            if json.loads(json.dumps(saved.get(key))) != wanted.get(key):
                 raise ValueError(
                     f"{run_dir} holds a run whose [{key}] settings differ from {spec.config}'s "
                     "(changed config or --set?): choose another --out"
