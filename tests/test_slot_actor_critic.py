@@ -86,6 +86,35 @@ def test_ppo_trains_only_on_valid_slots_and_survives_save_and_load(
     assert np.array_equal(loaded.predict(observation, deterministic=True)[0], expected)
 
 
+@pytest.mark.parametrize("scorer", ["mlp", "linear"])
+def test_a_prior_starts_the_actor_at_the_linear_scorer(scorer: str) -> None:
+    cfg = make_config("thesis-20x20", **EXPLORER)
+    env = make_batched_vec_env({"config": cfg}, 3, seed=0)
+    prior = np.random.default_rng(1).normal(size=env.observation_space["slots"].shape[1]) * 10
+    kwargs = {"scorer": scorer, "prior": prior.tolist()}
+    model = MaskablePPO(MaskableSlotActorCriticPolicy, env, n_steps=16, policy_kwargs=kwargs)
+    observation = env.reset()
+    observation["action_mask"][:, :3] = 1
+    scores = np.where(observation["action_mask"], observation["slots"] @ prior, -np.inf)
+    expected = np.exp(scores - scores.max(axis=1, keepdims=True))
+    expected /= expected.sum(axis=1, keepdims=True)
+    tensor = model.policy.obs_to_tensor(observation)[0]
+    probs = model.policy.get_distribution(tensor).distribution.probs.detach().numpy()
+    assert np.allclose(probs, expected, atol=1e-5)
+    assert np.array_equal(model.predict(observation, deterministic=True)[0], scores.argmax(1))
+
+
+def test_a_prior_by_feature_name_becomes_the_weight_vector() -> None:
+    kwargs = {"net_arch": [8], "prior": {"path": -32.0, "tour": -16.0}}
+    with_tour = {**EXPLORER, "tour": True}
+    experiment = experiment_from_dict(_experiment(ppo={"policy_kwargs": kwargs}, env=with_tour))
+    prior = experiment.hyperparameters()["policy_kwargs"]["prior"]
+    assert prior[0] == -32.0 and prior[-1] == -16.0 and set(prior[1:-1]) == {0.0}
+    assert experiment.to_dict()["ppo"]["policy_kwargs"]["prior"] == kwargs["prior"]
+    with pytest.raises(ValueError, match=r"prior names unknown feature\(s\) \['tour'\]"):
+        experiment_from_dict(_experiment(ppo={"policy_kwargs": kwargs}, env={**EXPLORER}))
+
+
 @pytest.mark.parametrize(
     ("policy_kwargs", "message"),
     [
@@ -93,6 +122,7 @@ def test_ppo_trains_only_on_valid_slots_and_survives_save_and_load(
         ({"scorer": "linear", "attention_heads": 2}, "attention_heads needs scorer='mlp'"),
         ({"net_arch": {"pi": [64], "vf": [64]}}, "net_arch of the slot actor-critic"),
         ({"ortho_init": True}, "ortho_init=False"),
+        ({"prior": [1.0, 2.0]}, "prior has 2 weights; the observation has"),
     ],
 )
 def test_bad_actor_critic_settings_are_refused(policy_kwargs: dict, message: str) -> None:

@@ -42,7 +42,7 @@ from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.thesis import DQN_HYPERPARAMETERS
 from frontier_marl.training.algorithms import SECTION, keyword_names
-from frontier_marl.training.cem import CEM_KEYS, CEMSettings
+from frontier_marl.training.cem import CEM_KEYS, CEMSettings, feature_names, weight_vector
 from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
 
 __all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
@@ -67,8 +67,18 @@ class Experiment:
     source: str | None = None
 
     def hyperparameters(self) -> dict[str, Any]:
-        """The keyword arguments of ``train.algorithm``'s SB3 class (``[dqn]`` or ``[ppo]``)."""
-        return self.ppo if self._uses_ppo() else self.dqn
+        """The keyword arguments of ``train.algorithm``'s SB3 class (``[dqn]`` or ``[ppo]``);
+        a ``policy_kwargs.prior`` given by feature name becomes the vector over the
+        observation's slot features (ValueError for a name that is not one)."""
+        if not self._uses_ppo():
+            return self.dqn
+        policy_kwargs = self.ppo.get("policy_kwargs", {})
+        prior = policy_kwargs.get("prior") if isinstance(policy_kwargs, Mapping) else None
+        if not isinstance(prior, Mapping):
+            return self.ppo
+        names = feature_names(self.env_config())
+        vector = weight_vector(prior, names, "ppo.policy_kwargs.prior").tolist()
+        return {**self.ppo, "policy_kwargs": {**policy_kwargs, "prior": vector}}
 
     def env_config(self) -> EnvConfig:
         """The validated env config (raises ``ValueError`` naming a bad env key); with
@@ -184,6 +194,10 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         experiment.env_config()
     except ValueError as exc:
         raise ValueError(f"[env]{where}: {exc}") from exc
+    try:
+        experiment.hyperparameters()
+    except ValueError as exc:
+        raise ValueError(f"[ppo]{where}: {exc}") from exc
     return experiment
 
 

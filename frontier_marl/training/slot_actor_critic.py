@@ -33,6 +33,7 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 from torch import nn
 
 from frontier_marl.training.slot_policy import (
+    LinearSlotScorer,
     SlotExtractor,
     make_scorer,
     mlp_layers,
@@ -65,7 +66,12 @@ class SlotValue(nn.Module):
 class SlotActorCritic(nn.Module):
     """SB3's ``mlp_extractor`` role: ``forward`` gives the actor's masked slot logits ``(B, S)``
     and the critic's value ``(B, 1)``; the policy's ``action_net`` and ``value_net`` are
-    identities."""
+    identities.
+
+    ``prior`` (one weight per slot feature) starts the actor at the linear scorer with those
+    weights: the linear scorer's weights themselves (``scorer = "linear"``), or a trainable
+    linear scorer plus the MLP scorer, whose output layer starts at zero (``"mlp"``), so that
+    the MLP learns a correction to the prior."""
 
     def __init__(
         self,
@@ -74,17 +80,39 @@ class SlotActorCritic(nn.Module):
         activation: type[nn.Module],
         scorer: str,
         attention_heads: int,
+        prior: list[float] | None = None,
     ) -> None:
         super().__init__()
         self.actor = make_scorer(scorer, extractor, hidden, activation, attention_heads)
         self.critic = SlotValue(extractor.n_slots, extractor.n_features, hidden, activation)
         self.latent_dim_pi, self.latent_dim_vf = extractor.n_slots, 1
+        self.prior: LinearSlotScorer | None = None
+        if prior is None:
+            return
+        if len(prior) != extractor.n_features:
+            raise ValueError(
+                f"prior has {len(prior)} weights; the observation has {extractor.n_features} "
+                "slot features"
+            )
+        weights = th.as_tensor(prior, dtype=th.float32)
+        with th.no_grad():
+            if isinstance(self.actor, LinearSlotScorer):
+                self.actor.weight.copy_(weights)
+                return
+            self.prior = LinearSlotScorer(extractor.n_slots, extractor.n_features)
+            self.prior.weight.copy_(weights)
+            output = self.actor.score[-1]
+            output.weight.zero_()
+            output.bias.zero_()
 
     def forward(self, features: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
         return self.forward_actor(features), self.forward_critic(features)
 
     def forward_actor(self, features: th.Tensor) -> th.Tensor:
-        return self.actor(features)
+        logits = self.actor(features)
+        if self.prior is None:
+            return logits
+        return logits + self.prior(features)  # masked slots: -2e9
 
     def forward_critic(self, features: th.Tensor) -> th.Tensor:
         return self.critic(features)
@@ -93,13 +121,15 @@ class SlotActorCritic(nn.Module):
 class _SlotActorCriticMixin:
     """What both policy classes share: the slot extractor, :class:`SlotActorCritic` in place of
     SB3's MLP extractor, identity action and value heads, and the extra constructor keywords
-    (``scorer``, ``attention_heads``) saved with the model."""
+    (``scorer``, ``attention_heads``, ``prior``: :class:`SlotActorCritic`) saved with the
+    model."""
 
     def __init__(
         self,
         *args: Any,
         scorer: str = "mlp",
         attention_heads: int = 0,
+        prior: list[float] | None = None,
         net_arch: list[int] | None = None,
         ortho_init: bool = False,
         **kwargs: Any,
@@ -115,6 +145,7 @@ class _SlotActorCriticMixin:
         kwargs.setdefault("features_extractor_class", SlotExtractor)
         # read by _build_mlp_extractor during super().__init__
         self.scorer, self.attention_heads, self.hidden = scorer, attention_heads, hidden
+        self.prior = None if prior is None else [float(w) for w in prior]
         super().__init__(*args, net_arch=hidden, ortho_init=False, **kwargs)  # type: ignore[call-arg]
 
     def _build_mlp_extractor(self) -> None:
@@ -127,6 +158,7 @@ class _SlotActorCriticMixin:
             self.activation_fn,  # type: ignore[attr-defined]
             self.scorer,
             self.attention_heads,
+            self.prior,
         )
 
     def _build(self, lr_schedule: Any) -> None:
@@ -144,6 +176,7 @@ class _SlotActorCriticMixin:
             **super()._get_constructor_parameters(),  # type: ignore[misc]
             "scorer": self.scorer,
             "attention_heads": self.attention_heads,
+            "prior": self.prior,
             "net_arch": self.hidden,
         }
 
