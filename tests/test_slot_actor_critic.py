@@ -90,8 +90,9 @@ def test_ppo_trains_only_on_valid_slots_and_survives_save_and_load(
 def test_a_prior_starts_the_actor_at_the_linear_scorer(scorer: str) -> None:
     cfg = make_config("thesis-20x20", **EXPLORER)
     env = make_batched_vec_env({"config": cfg}, 3, seed=0)
-    prior = np.random.default_rng(1).normal(size=env.observation_space["slots"].shape[1]) * 10
-    kwargs = {"scorer": scorer, "prior": prior.tolist()}
+    prior = np.random.default_rng(1).normal(size=env.observation_space["slots"].shape[1])
+    kwargs = {"scorer": scorer, "prior": prior.tolist(), "logit_scale": 10}
+    prior = prior * 10
     model = MaskablePPO(MaskableSlotActorCriticPolicy, env, n_steps=16, policy_kwargs=kwargs)
     observation = env.reset()
     observation["action_mask"][:, :3] = 1
@@ -123,6 +124,8 @@ def test_a_prior_by_feature_name_becomes_the_weight_vector() -> None:
         ({"net_arch": {"pi": [64], "vf": [64]}}, "net_arch of the slot actor-critic"),
         ({"ortho_init": True}, "ortho_init=False"),
         ({"prior": [1.0, 2.0]}, "prior has 2 weights; the observation has"),
+        ({"logit_scale": 0}, r"logit_scale must be in \(0, 1e4\)"),
+        ({"logit_scale": "big"}, "logit_scale must be a number"),
     ],
 )
 def test_bad_actor_critic_settings_are_refused(policy_kwargs: dict, message: str) -> None:

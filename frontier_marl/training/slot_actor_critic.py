@@ -71,7 +71,10 @@ class SlotActorCritic(nn.Module):
     ``prior`` (one weight per slot feature) starts the actor at the linear scorer with those
     weights: the linear scorer's weights themselves (``scorer = "linear"``), or a trainable
     linear scorer plus the MLP scorer, whose output layer starts at zero (``"mlp"``), so that
-    the MLP learns a correction to the prior."""
+    the MLP learns a correction to the prior. ``logit_scale`` multiplies the actor's scores
+    into logits: with a prior in the linear scorer's own units (a path weight of -1 per 32
+    cells), 32 makes one cell of path one unit of logit, while the weights the optimizer
+    moves stay of order 1."""
 
     def __init__(
         self,
@@ -81,8 +84,14 @@ class SlotActorCritic(nn.Module):
         scorer: str,
         attention_heads: int,
         prior: list[float] | None = None,
+        logit_scale: float = 1.0,
     ) -> None:
         super().__init__()
+        if isinstance(logit_scale, bool) or not isinstance(logit_scale, int | float):
+            raise ValueError(f"logit_scale must be a number > 0, got {logit_scale!r}")
+        if not 0 < logit_scale < 1e4:
+            raise ValueError(f"logit_scale must be in (0, 1e4), got {logit_scale!r}")
+        self.logit_scale = float(logit_scale)
         self.actor = make_scorer(scorer, extractor, hidden, activation, attention_heads)
         self.critic = SlotValue(extractor.n_slots, extractor.n_features, hidden, activation)
         self.latent_dim_pi, self.latent_dim_vf = extractor.n_slots, 1
@@ -110,9 +119,9 @@ class SlotActorCritic(nn.Module):
 
     def forward_actor(self, features: th.Tensor) -> th.Tensor:
         logits = self.actor(features)
-        if self.prior is None:
-            return logits
-        return logits + self.prior(features)  # masked slots: -2e9
+        if self.prior is not None:
+            logits = logits + self.prior(features)  # masked slots: -2e9
+        return logits * self.logit_scale
 
     def forward_critic(self, features: th.Tensor) -> th.Tensor:
         return self.critic(features)
@@ -121,8 +130,8 @@ class SlotActorCritic(nn.Module):
 class _SlotActorCriticMixin:
     """What both policy classes share: the slot extractor, :class:`SlotActorCritic` in place of
     SB3's MLP extractor, identity action and value heads, and the extra constructor keywords
-    (``scorer``, ``attention_heads``, ``prior``: :class:`SlotActorCritic`) saved with the
-    model."""
+    (``scorer``, ``attention_heads``, ``prior``, ``logit_scale``: :class:`SlotActorCritic`)
+    saved with the model."""
 
     def __init__(
         self,
@@ -130,6 +139,7 @@ class _SlotActorCriticMixin:
         scorer: str = "mlp",
         attention_heads: int = 0,
         prior: list[float] | None = None,
+        logit_scale: float = 1.0,
         net_arch: list[int] | None = None,
         ortho_init: bool = False,
         **kwargs: Any,
@@ -146,6 +156,7 @@ class _SlotActorCriticMixin:
         # read by _build_mlp_extractor during super().__init__
         self.scorer, self.attention_heads, self.hidden = scorer, attention_heads, hidden
         self.prior = None if prior is None else [float(w) for w in prior]
+        self.logit_scale = logit_scale
         super().__init__(*args, net_arch=hidden, ortho_init=False, **kwargs)  # type: ignore[call-arg]
 
     def _build_mlp_extractor(self) -> None:
@@ -159,6 +170,7 @@ class _SlotActorCriticMixin:
             self.scorer,
             self.attention_heads,
             self.prior,
+            self.logit_scale,
         )
 
     def _build(self, lr_schedule: Any) -> None:
@@ -177,6 +189,7 @@ class _SlotActorCriticMixin:
             "scorer": self.scorer,
             "attention_heads": self.attention_heads,
             "prior": self.prior,
+            "logit_scale": self.logit_scale,
             "net_arch": self.hidden,
         }
 
