@@ -124,8 +124,8 @@ def test_a_prior_by_feature_name_becomes_the_weight_vector() -> None:
         ({"net_arch": {"pi": [64], "vf": [64]}}, "net_arch of the slot actor-critic"),
         ({"ortho_init": True}, "ortho_init=False"),
         ({"prior": [1.0, 2.0]}, "prior has 2 weights; the observation has"),
-        ({"logit_scale": 0}, r"logit_scale must be in \(0, 1e4\)"),
-        ({"logit_scale": "big"}, "logit_scale must be a number"),
+        ({"logit_scale": 0}, r"logit_scale must be a number in \(0, 1e4\)"),
+        ({"logit_scale": "big"}, "logit_scale must be a number in"),
     ],
 )
 def test_bad_actor_critic_settings_are_refused(policy_kwargs: dict, message: str) -> None:
@@ -217,3 +217,18 @@ def test_train_explorer_ppo_resume_and_benchmark(tmp_path: Path) -> None:
     assert code == 0
     rows = json.loads(out.read_text())["rows"]
     assert [row["success"] for row in rows if row["policy"] == "ppo"] == [1]  # the folder name
+
+
+def test_the_shipped_explorer_ppo_loads_and_explores(tmp_path: Path) -> None:
+    loaded = load_model("explorer-ppo")
+    assert isinstance(loaded.model, MaskablePPO)
+    assert type(loaded.model.policy) is MaskableSlotActorCriticPolicy
+    assert loaded.metadata["experiment"]["train"]["algorithm"] == "maskable-ppo"
+    out = tmp_path / "bench.json"
+    code = main(
+        ["benchmark", "--policies", "explorer-ppo", "--families", "rooms-32", "--episodes", "2",
+         "--split", "validation", "--json", str(out), "--no-progress"]
+    )  # fmt: skip
+    assert code == 0
+    (row,) = json.loads(out.read_text())["rows"]
+    assert row["policy"] == "explorer-ppo" and row["success"] == row["episodes"] == 2

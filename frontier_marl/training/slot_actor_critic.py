@@ -87,10 +87,9 @@ class SlotActorCritic(nn.Module):
         logit_scale: float = 1.0,
     ) -> None:
         super().__init__()
-        if isinstance(logit_scale, bool) or not isinstance(logit_scale, int | float):
-            raise ValueError(f"logit_scale must be a number > 0, got {logit_scale!r}")
-        if not 0 < logit_scale < 1e4:
-            raise ValueError(f"logit_scale must be in (0, 1e4), got {logit_scale!r}")
+        number = isinstance(logit_scale, int | float) and not isinstance(logit_scale, bool)
+        if not number or not 0 < logit_scale < 1e4:
+            raise ValueError(f"logit_scale must be a number in (0, 1e4), got {logit_scale!r}")
         self.logit_scale = float(logit_scale)
         self.actor = make_scorer(scorer, extractor, hidden, activation, attention_heads)
         self.critic = SlotValue(extractor.n_slots, extractor.n_features, hidden, activation)
@@ -195,7 +194,7 @@ class _SlotActorCriticMixin:
 
 
 class SlotActorCriticPolicy(_SlotActorCriticMixin, ActorCriticPolicy):
-    """SB3 ``PPO`` (or ``A2C``) policy over the explorer observation: masked, equivariant."""
+    """SB3 ``PPO`` policy over the explorer observation: masked, equivariant."""
 
 
 class MaskableSlotActorCriticPolicy(_SlotActorCriticMixin, MaskableActorCriticPolicy):
