@@ -232,3 +232,50 @@ def test_the_shipped_explorer_ppo_loads_and_explores(tmp_path: Path) -> None:
     assert code == 0
     (row,) = json.loads(out.read_text())["rows"]
     assert row["policy"] == "explorer-ppo" and row["success"] == row["episodes"] == 2
+
+
+@pytest.mark.parametrize("name", ["explorer", "explorer-ppo"])
+def test_skipping_forced_steps_leaves_the_slot_scorers_episodes_unchanged(name: str) -> None:
+    """A slot scorer is not asked when one slot is valid; it would have taken that slot."""
+    from frontier_marl.envs.parallel import FrontierParallelEnv
+
+    loaded = load_model(name)
+    cfg = loaded.env_config()
+    runs = []
+    for skips in (True, False):
+        policy = ModelPolicy(loaded.model)
+        assert policy.skips_forced  # the slot scorers mask invalid slots themselves
+        policy.skips_forced = skips
+        env = FrontierParallelEnv(config=cfg)
+        observations, infos = env.reset(seed=3)
+        actions, choices = [], []
+        for _ in range(60):
+            agent = env.agents[0]
+            choices.append(int(np.count_nonzero(infos[agent]["action_mask"])))
+            actions.append(policy.act(observations[agent], infos[agent]))
+            observations, _, terminated, truncated, infos = env.step({agent: actions[-1]})
+            if terminated[agent] or truncated[agent]:
+                break
+        runs.append(actions)
+    assert runs[0] == runs[1]
+    assert 1 in choices and max(choices) > 1  # forced steps and real decisions both played
+
+
+def test_forced_steps_are_not_asked_of_a_masking_model() -> None:
+    class Masking:
+        class policy:  # noqa: N801
+            masks_invalid_slots = True
+
+        def __init__(self) -> None:
+            self.calls = 0
+
+        def predict(self, obs, deterministic=True):  # noqa: ANN001, ANN202
+            self.calls += 1
+            return np.array(0), None
+
+    model = Masking()
+    assert ModelPolicy(model).act({}, {"action_mask": np.array([0, 0, 1, 0])}) == 2
+    assert model.calls == 0
+    ModelPolicy(model).act({}, {"action_mask": np.array([1, 0, 1, 0])})
+    ModelPolicy(model, deterministic=False).act({}, {"action_mask": np.array([0, 0, 1, 0])})
+    assert model.calls == 2

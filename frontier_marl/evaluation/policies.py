@@ -147,7 +147,9 @@ class CallablePolicy(Policy):
 class ModelPolicy(Policy):
     """Wraps a model with SB3's ``predict(obs, deterministic=...) -> (action, state)``; a
     model whose ``predict`` takes ``action_masks`` (sb3-contrib's ``MaskablePPO``) gets the
-    env's action mask (``info["action_mask"]``)."""
+    env's action mask (``info["action_mask"]``). A deterministic model whose policy masks
+    invalid slots itself (``policy.masks_invalid_slots``: the slot scorers) is not asked when
+    one slot is valid (a commitment, the last cluster): it would take that slot anyway."""
 
     def __init__(self, model: Any, name: str = "model", deterministic: bool = True) -> None:
         if not hasattr(model, "predict"):
@@ -156,8 +158,14 @@ class ModelPolicy(Policy):
         self.name = name
         self.deterministic = deterministic
         self.takes_masks = "action_masks" in inspect.signature(model.predict).parameters
+        masks_itself = getattr(getattr(model, "policy", None), "masks_invalid_slots", False)
+        self.skips_forced = deterministic and masks_itself is True
 
     def act(self, obs: Any, info: Info) -> int:
+        if self.skips_forced and "action_mask" in info:
+            valid = np.flatnonzero(info["action_mask"])
+            if len(valid) == 1:
+                return int(valid[0])
         masks = {}
         if self.takes_masks and "action_mask" in info:
             masks["action_masks"] = np.asarray(info["action_mask"], dtype=bool)

@@ -132,6 +132,8 @@ class _SlotActorCriticMixin:
     (``scorer``, ``attention_heads``, ``prior``, ``logit_scale``: :class:`SlotActorCritic`)
     saved with the model."""
 
+    masks_invalid_slots = True  # masked slots have probability 0
+
     def __init__(
         self,
         *args: Any,

@@ -181,6 +181,8 @@ class SlotQNetwork(QNetwork):
 class SlotDQNPolicy(DQNPolicy):
     """DQN policy with :class:`SlotQNetwork` (online and target)."""
 
+    masks_invalid_slots = True  # its greedy action is always a valid slot
+
     def __init__(
         self, *args: Any, attention_heads: int = 0, scorer: str = "mlp", **kwargs: Any
     ) -> None:
