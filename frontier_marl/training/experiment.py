@@ -164,11 +164,11 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     ppo = dict(data.get("ppo", {}))
     _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
     if ppo:
-        bad_ppo = set(ppo) - keyword_names(settings.algorithm)
-        if bad_ppo:
+        allowed = keyword_names(settings.algorithm)
+        if set(ppo) - allowed:
             raise ValueError(
-                f"unknown or reserved [ppo] key(s) {sorted(bad_ppo)}{where}; allowed: "
-                f"{sorted(keyword_names(settings.algorithm))} (seed and device are set in [train])"
+                f"unknown or reserved [ppo] key(s) {sorted(set(ppo) - allowed)}{where}; "
+                f"allowed: {sorted(allowed)} (seed and device are set in [train])"
             )
         _check_ranges("ppo", ppo, where)
     cem = dict(data.get("cem", {}))
@@ -217,38 +217,37 @@ def _check_sections(algorithm: str, has_dqn: bool, has_ppo: bool, where: str) ->
         )
 
 
-#: Ranges of the settings checked before SB3 sees them: section -> key -> (kind, low, high).
-_DQN_RANGES: dict[str, tuple[str, float, float]] = {
+#: Ranges of the settings checked before SB3 sees them: key -> (kind, low, high); first the
+#: keywords DQN and PPO share, then each one's own.
+_SHARED_RANGES: dict[str, tuple[str, float, float]] = {
     "learning_rate": ("float", 0.0, math.inf),
-    "exploration_fraction": ("float", 0.0, 1.0),
-    "exploration_initial_eps": ("float", 0.0, 1.0),
-    "exploration_final_eps": ("float", 0.0, 1.0),
     "gamma": ("float", 0.0, 1.0),
-    "tau": ("float", 0.0, 1.0),
     "max_grad_norm": ("float", 0.0, math.inf),
     "batch_size": ("int", 1, math.inf),
-    "buffer_size": ("int", 1, math.inf),
-    "learning_starts": ("int", 0, math.inf),
-    "target_update_interval": ("int", 1, math.inf),
-    "train_freq": ("int", 1, math.inf),
-    "gradient_steps": ("int", -1, math.inf),
     "n_steps": ("int", 1, math.inf),
 }
-
-
-_PPO_RANGES: dict[str, tuple[str, float, float]] = {
-    "learning_rate": ("float", 0.0, math.inf),
-    "n_steps": ("int", 1, math.inf),
-    "batch_size": ("int", 1, math.inf),
-    "n_epochs": ("int", 1, math.inf),
-    "gamma": ("float", 0.0, 1.0),
-    "gae_lambda": ("float", 0.0, 1.0),
-    "clip_range": ("float", 0.0, math.inf),
-    "ent_coef": ("float", 0.0, math.inf),
-    "vf_coef": ("float", 0.0, math.inf),
-    "max_grad_norm": ("float", 0.0, math.inf),
+_RANGES: dict[str, dict[str, tuple[str, float, float]]] = {
+    "dqn": {
+        **_SHARED_RANGES,
+        "exploration_fraction": ("float", 0.0, 1.0),
+        "exploration_initial_eps": ("float", 0.0, 1.0),
+        "exploration_final_eps": ("float", 0.0, 1.0),
+        "tau": ("float", 0.0, 1.0),
+        "buffer_size": ("int", 1, math.inf),
+        "learning_starts": ("int", 0, math.inf),
+        "target_update_interval": ("int", 1, math.inf),
+        "train_freq": ("int", 1, math.inf),
+        "gradient_steps": ("int", -1, math.inf),
+    },
+    "ppo": {
+        **_SHARED_RANGES,
+        "n_epochs": ("int", 1, math.inf),
+        "gae_lambda": ("float", 0.0, 1.0),
+        "clip_range": ("float", 0.0, math.inf),
+        "ent_coef": ("float", 0.0, math.inf),
+        "vf_coef": ("float", 0.0, math.inf),
+    },
 }
-_RANGES = {"dqn": _DQN_RANGES, "ppo": _PPO_RANGES}
 
 
 def _check_ranges(section: str, values: Mapping[str, Any], where: str) -> None:
