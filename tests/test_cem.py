@@ -216,3 +216,32 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
     for bad in (["--first", "800000"], ["--radii", "a"]):
         with pytest.raises(SystemExit):
             probe["main"](bad)
+
+
+def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_path: Path) -> None:
+    import runpy
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_weight_sensitivity.py"
+    sensitivity = runpy.run_path(str(script))
+    names = ["path", "size", "tour", "unknown_near"]
+    weights = np.array([-1.0, 0.8, -0.5, -0.4])
+    lengths = sensitivity["scaled"](weights, names, "lengths", 2.0)
+    assert lengths.tolist() == [-2.0, 0.8, -1.0, -0.4]
+    assert sensitivity["scaled"](weights, names, "size", 0.5).tolist() == [-1.0, 0.4, -0.5, -0.4]
+    out = tmp_path / "sensitivity.json"
+    argv = ["--directions", "tour:1,lengths:3", "--seed-sets", "730000,731000", "--episodes", "2"]
+    assert sensitivity["main"]([*argv, "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert len(rows) == 5 * 2 * 2  # families x seed sets x directions
+    unchanged = [row for row in rows if row["direction"] == "tour:1"]
+    assert all(row["change"] == 0.0 for row in unchanged)  # the same weights, the same episodes
+    assert {row["first_seed"] for row in rows} == {730000, 731000}
+    bad_inputs = (
+        ["--seed-sets", "800000"],  # a validation seed
+        ["--seed-sets", "730000,730001", "--episodes", "2"],  # overlapping sets
+        ["--directions", "tuor:2"],
+        ["--directions", "tour"],
+    )
+    for bad in bad_inputs:
+        with pytest.raises(SystemExit):
+            sensitivity["main"](bad)
