@@ -23,8 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from frontier_marl.evaluation.families import TRAIN_SEEDS
-from frontier_marl.pretrained import pretrained_model_dir
-from frontier_marl.training.cem import feature_names, play_t99, relative_t99, weight_vector
+from frontier_marl.training.cem import (
+    changes_text,
+    feature_names,
+    paired_change,
+    play_t99,
+    shipped_weights,
+    weight_vector,
+)
 from frontier_marl.training.experiment import load_experiment
 
 DIRECTIONS = "lengths:1.25,lengths:1.6,tour:0.8,tour:1.25,unknown_near:0.7,unknown_near:1.4"
@@ -59,6 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--episodes", type=int, default=64, help="episodes per family and set")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
+    if args.episodes < 2:
+        parser.error(f"--episodes must be at least 2 (for the standard error), got {args.episodes}")
     try:
         firsts = [int(first) for first in args.seed_sets.split(",")]
     except ValueError:
@@ -69,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     if ranges[0][0] < TRAIN_SEEDS.start or ranges[-1][1] > TRAIN_SEEDS.stop:
         parser.error(f"every seed set must lie in the training seeds, {TRAIN_SEEDS}")
     experiment = load_experiment("explorer")
-    shipped = json.loads((pretrained_model_dir("explorer") / "model.json").read_text())["weights"]
+    shipped = shipped_weights()
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
@@ -84,22 +92,16 @@ def main(argv: list[str] | None = None) -> int:
             reference, _ = play_t99(cfg, seeds, weights)
             for name, factor in directions:
                 t99, _ = play_t99(cfg, seeds, scaled(weights, names, name, factor))
-                change = relative_t99(t99, reference)
                 rows.append(
                     {
                         "family": family,
                         "first_seed": first,
                         "direction": f"{name}:{factor:g}",
-                        "change": float(change.mean()),
-                        "stderr": float(change.std(ddof=1) / np.sqrt(change.size)),
+                        **paired_change(t99, reference),
                     }
                 )
-        cells = "  ".join(
-            f"{row['direction']}@{row['first_seed']} {100 * row['change']:+.2f}"
-            f"±{100 * row['stderr']:.2f}"
-            for row in rows
-            if row["family"] == family
-        )
+        mine = [row for row in rows if row["family"] == family]
+        cells = changes_text({f"{row['direction']}@{row['first_seed']}": row for row in mine})
         print(f"{family}: {cells}  ({time.perf_counter() - started:.0f} s)", flush=True)
     if args.json is not None:
         options = {"episodes": args.episodes, "seed_sets": firsts, "directions": args.directions}

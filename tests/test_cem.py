@@ -241,7 +241,52 @@ def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_p
         ["--seed-sets", "730000,730001", "--episodes", "2"],  # overlapping sets
         ["--directions", "tuor:2"],
         ["--directions", "tour"],
+        ["--episodes", "1"],
     )
     for bad in bad_inputs:
         with pytest.raises(SystemExit):
             sensitivity["main"](bad)
+
+
+def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_path: Path) -> None:
+    import runpy
+
+    from frontier_marl.training.cem import play_scorer
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_true_gain_probe.py"
+    probe = runpy.run_path(str(script))
+    cfg = load_experiment("explorer").env_configs()[2]  # rooms-32
+    checked = []
+
+    def score(observations: dict, env) -> np.ndarray:
+        true, belief = probe["disc_gains"](env, "true"), probe["disc_gains"](env, "belief")
+        valid = observations["action_mask"].astype(bool)
+        assert np.all(true[~valid] == 0) and np.all(belief[~valid] == 0)
+        assert np.all((true >= 0) & (true <= belief + 1e-12) & (belief <= 1))
+        checked.append(true[valid].sum())
+        return -observations["slots"][..., 0].astype(np.float64)  # nearest-path
+
+    play_scorer(cfg, [3, 4, 5], score)
+    assert len(checked) > 10 and sum(checked) > 0  # decisions with something to reveal
+    out = tmp_path / "probe.json"
+    argv = ["--weights=0,0.1", "--kinds", "true", "--episodes", "2", "--json", str(out)]
+    assert probe["main"](argv) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert len(rows) == 5 * 2
+    assert all(row["change"] == 0.0 for row in rows if row["weight"] == 0)
+    for bad in (
+        ["--first", "900000"],
+        ["--kinds", "oracle"],
+        ["--weights", "a"],
+        ["--episodes", "1"],
+    ):
+        with pytest.raises(SystemExit):
+            probe["main"](bad)
+
+
+def test_paired_change_is_the_mean_relative_t99_and_its_standard_error() -> None:
+    from frontier_marl.training.cem import changes_text, paired_change
+
+    change = paired_change(np.array([110.0, 90.0]), np.array([100.0, 100.0]))
+    assert change["change"] == pytest.approx(0.0) and change["stderr"] == pytest.approx(0.1)
+    assert changes_text({"a": change}) == "a +0.00±10.00"

@@ -157,6 +157,30 @@ def relative_t99(t99: np.ndarray, reference: np.ndarray) -> np.ndarray:
     return np.where(both, t99 / np.where(both, reference, 1.0) - 1.0, FAILURE)
 
 
+def paired_change(t99: np.ndarray, reference: np.ndarray) -> dict[str, float]:
+    """The mean of :func:`relative_t99` over two or more episodes (``change``) and its
+    standard error (``stderr``)."""
+    change = relative_t99(t99, reference)
+    return {
+        "change": float(change.mean()),
+        "stderr": float(change.std(ddof=1) / np.sqrt(change.size)),
+    }
+
+
+def changes_text(changes: Mapping[str, Mapping[str, float]]) -> str:
+    """``label change±stderr`` in percent for each labelled :func:`paired_change`."""
+    return "  ".join(
+        f"{label} {100 * c['change']:+.2f}±{100 * c['stderr']:.2f}" for label, c in changes.items()
+    )
+
+
+def shipped_weights(name: str = "explorer") -> dict[str, float]:
+    """The weights by feature name of the shipped linear scorer ``name``."""
+    from frontier_marl.pretrained import pretrained_model_dir
+
+    return json.loads((pretrained_model_dir(name) / "model.json").read_text())["weights"]
+
+
 def candidate_score(
     configs: list[EnvConfig],
     seeds: list[list[int]],
