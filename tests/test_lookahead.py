@@ -110,3 +110,54 @@ def test_imitation_labels_real_decisions_and_fits_them() -> None:
 
     losses = fit(Net(), data, 20, 32, 1e-2, torch.Generator().manual_seed(0))
     assert len(losses) == 20 and losses[-1] < losses[0]
+
+
+def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
+    import runpy
+    from pathlib import Path
+
+    from frontier_marl import FrontierParallelEnv
+    from frontier_marl.core.slots import SlotArrays
+    from frontier_marl.training.cem import feature_names
+    from frontier_marl.training.evaluate_model import load_model
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
+    probe = runpy.run_path(str(script))
+    cfg = load_model("explorer").env_config()
+    path_only = np.array([-1.0 if name == "path" else 0.0 for name in feature_names(cfg)])
+    base = probe["LinearScorerBase"](cfg, path_only)  # nearest-path among the 12 slots
+    env = FrontierParallelEnv(config=cfg)
+    for seed in range(5):
+        env.reset(seed=seed)
+        sims, index = env.world.batch, np.array([env.world.index])
+        slots = SlotArrays.empty(sims.belief.shape[0], 1, base.n_slots)
+        sims.slots(slots, index, False)
+        goal = base.goals(sims, slots, index)[0]
+        lengths = slots.path_length[index[0], 0]
+        live = np.flatnonzero(slots.valid[index[0], 0])
+        chosen = [s for s in live if (slots.target[index[0], 0, s] == goal).all()]
+        assert len(live) > 1 and chosen and lengths[chosen[0]] == lengths[live].min()
+        slots.valid[index[0], 0] = False
+        assert (base.goals(sims, slots, index)[0] == -1).all()  # nothing left: no goal
+    env.close()
+
+
+def test_the_rollout_probe_scores_both_oracles_on_validation_episodes(tmp_path) -> None:
+    import json
+    import runpy
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
+    probe = runpy.run_path(str(script))["main"]
+    out = tmp_path / "probe.json"
+    assert (
+        probe(["--families", "random-20", "--episodes", "2", "--json", str(out), "--no-progress"])
+        == 0
+    )
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["policy"] for row in rows] == [
+        "nearest-path", "explorer", "lookahead-oracle", "explorer-rollout"
+    ]  # fmt: skip
+    assert all(row["seeds"] == [800_000, 800_001] and row["success"] == 2 for row in rows)
+    with pytest.raises(SystemExit):
+        probe(["--families", "rooms-128"])

@@ -12,13 +12,15 @@ clusters can gain, not a heuristic; :mod:`frontier_marl.training.imitation` labe
 with its costs for a student that sees only its own observation.
 
 The base policy of the simulations keeps a target while it is still a frontier cell and then
-picks the nearest cluster by known-free path (ties: nearest centroid), one cell per move.
+picks the next one: by default the nearest cluster by known-free path (ties: nearest
+centroid, :class:`NearestPathBase`), one cell per move; any :class:`RolloutBase` can take its
+place (benchmarks/explorer_rollout_probe.py finishes the simulations with the explorer).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -56,13 +58,32 @@ def _still_frontier(belief: np.ndarray, goals: np.ndarray, worlds: np.ndarray) -
     return out
 
 
-def _nearest_path(slots: SlotArrays, world: int) -> np.ndarray | None:
-    """Robot 0's nearest live slot target by path length (ties: centroid distance)."""
-    live = np.flatnonzero(slots.valid[world, 0])
-    if not len(live):
-        return None
-    best = first_by(slots.path_length[world, 0, live], slots.distance[world, 0, live])
-    return slots.target[world, 0, live[best]]
+class NearestPathBase:
+    """The rollouts' default base policy: robot 0's nearest live slot target by known-free
+    path (ties: nearest centroid), among every reachable cluster."""
+
+    n_slots = ROLLOUT_SLOTS
+    gain = "size"  # reads no gain: the cheapest gain model, no unknown cells counted
+
+    def goals(self, sims: Worlds, slots: SlotArrays, deciding: np.ndarray) -> np.ndarray:
+        """(len(deciding), 2) next targets of the ``deciding`` simulations (row -1: none)."""
+        goals = np.full((len(deciding), 2), -1, dtype=np.int64)
+        for k, world in enumerate(deciding.tolist()):
+            live = np.flatnonzero(slots.valid[world, 0])
+            if len(live):
+                best = first_by(slots.path_length[world, 0, live], slots.distance[world, 0, live])
+                goals[k] = slots.target[world, 0, live[best]]
+        return goals
+
+
+class RolloutBase(Protocol):
+    """A base policy for the rollouts: ``n_slots`` slots per decision, the ``gain`` model of
+    the simulations, and :meth:`goals`, as :class:`NearestPathBase`."""
+
+    n_slots: int
+    gain: str
+
+    def goals(self, sims: Worlds, slots: SlotArrays, deciding: np.ndarray) -> np.ndarray: ...
 
 
 def lookahead_costs(
@@ -71,20 +92,22 @@ def lookahead_costs(
     targets: np.ndarray,
     coverage: float,
     max_cells: int,
+    base: RolloutBase | None = None,
 ) -> np.ndarray:
     """Cells travelled by robot 0 of world ``index`` until ``coverage`` of the reachable free
-    region is known, if it first walks to ``targets[m]`` (M, 2) and nearest-path finishes;
-    ``max_cells`` caps each simulation (a simulation that stalls costs ``max_cells``)."""
+    region is known, if it first walks to ``targets[m]`` (M, 2) and ``base`` (default:
+    :class:`NearestPathBase`) finishes; ``max_cells`` caps each simulation (a simulation that
+    stalls costs ``max_cells``)."""
     if source.n_agents != 1:
         raise ValueError(f"the lookahead teacher drives one robot, got {source.n_agents}")
     targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
     count = len(targets)
-    # nearest-path reads no gain: the cheapest gain saves counting unknown cells
-    sims = Worlds(source.shape, count, 1, replace(source.params, gain="size"))
+    base = NearestPathBase() if base is None else base
+    sims = Worlds(source.shape, count, 1, replace(source.params, gain=base.gain))
     copy_world(source, index, sims, np.arange(count))
     start = int(source.travelled[index, 0])
     sims.goals[:, 0] = targets
-    slots = SlotArrays.empty(count, 1, ROLLOUT_SLOTS)
+    slots = SlotArrays.empty(count, 1, base.n_slots)
     done = np.zeros(count, dtype=bool)
     cost = np.full(count, max_cells, dtype=np.int64)
     while True:
@@ -100,25 +123,24 @@ def lookahead_costs(
         deciding = active[~keep]
         if len(deciding):
             sims.slots(slots, deciding, False)
-            for world in deciding.tolist():
-                goal = _nearest_path(slots, world)
-                if goal is None:  # nothing reachable is left to explore: it cannot finish
-                    done[world] = True
-                else:
-                    sims.goals[world, 0] = goal
+            goals = base.goals(sims, slots, deciding)
+            stuck = goals[:, 0] < 0  # nothing reachable is left to explore: it cannot finish
+            done[deciding[stuck]] = True
+            sims.goals[deciding[~stuck], 0] = goals[~stuck]
         sims.move(sims.goals, ~done)  # resets ``reached`` of every world it moves
 
 
 class LookaheadOracle(HeuristicPolicy):
-    """The cheapest live slot by :func:`lookahead_costs` (ties: nearest path, then nearest
-    centroid), kept until reached (``commit = "until-reached"``). One robot only; it reads
-    the attached env's world, true map included, and its coverage level
-    (``explore_threshold`` of the reachable free cells)."""
+    """The cheapest live slot by :func:`lookahead_costs` with rollout ``base`` (default
+    nearest-path; ties: nearest path, then nearest centroid), kept until reached (``commit =
+    "until-reached"``). One robot only; it reads the attached env's world, true map included,
+    and its coverage level (``explore_threshold`` of the reachable free cells)."""
 
     name = "lookahead-oracle"
 
-    def __init__(self) -> None:
+    def __init__(self, base: RolloutBase | None = None) -> None:
         super().__init__("until-reached")
+        self.base = base
         self._env: Any = None
 
     def attach(self, env: Any) -> None:
@@ -138,6 +160,6 @@ class LookaheadOracle(HeuristicPolicy):
         live = table.live
         coverage = self._env.config.reward.explore_threshold
         costs = lookahead_costs(
-            world.batch, world.index, table.target[:live], coverage, 4 * height * width
+            world.batch, world.index, table.target[:live], coverage, 4 * height * width, self.base
         )
         return first_by(costs, table.path_length[:live], table.distance[:live])
