@@ -33,7 +33,8 @@ from frontier_marl.training.evaluate_model import load_model
 
 class LinearScorerBase:
     """A rollout base policy (:class:`~frontier_marl.evaluation.lookahead.RolloutBase`): the
-    linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own)."""
+    linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own; the
+    simulations keep no heading, so the ``current`` feature reads 0)."""
 
     def __init__(self, cfg: EnvConfig, weights: np.ndarray) -> None:
         self.encoder = ObservationEncoder(cfg)
