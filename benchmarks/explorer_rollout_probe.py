@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +29,6 @@ from frontier_marl.evaluation.families import FAMILIES, check_families, family
 from frontier_marl.evaluation.lookahead import LookaheadOracle
 from frontier_marl.observations import ObservationEncoder
 from frontier_marl.training.cem import feature_names, shipped_weights, weight_vector
-from frontier_marl.training.evaluate_model import load_model
 
 
 class LinearScorerBase:
@@ -54,26 +54,28 @@ class LinearScorerBase:
 
 
 class ExplorerRollout(LookaheadOracle):
-    """The lookahead oracle whose rollouts the linear scorer ``weights`` finishes, on the
-    observation of the env it is attached to (the model's own, on the family's world)."""
+    """The lookahead oracle whose rollouts the linear scorer ``weights`` (by feature name)
+    finishes, on the observation of the env it is attached to (the model's own, on the
+    family's world)."""
 
     name = "explorer-rollout"
 
-    def __init__(self, weights: np.ndarray) -> None:
+    def __init__(self, weights: Mapping[str, float]) -> None:
         super().__init__()
         self.weights = weights
 
     def attach(self, env: Any) -> None:
         super().attach(env)
-        self.base = LinearScorerBase(env.config, self.weights)
+        vector = weight_vector(self.weights, feature_names(env.config), "the scorer's weights")
+        self.base = LinearScorerBase(env.config, vector)
 
 
 def explorer_rollout() -> Contender:
     """``explorer-rollout`` with the shipped explorer's weights, in the explorer's env."""
-    explorer = model("explorer")
-    names = feature_names(load_model("explorer").env_config())
-    weights = weight_vector(shipped_weights(), names, "the explorer's weights")
-    return Contender(ExplorerRollout.name, False, lambda: ExplorerRollout(weights), explorer.config)
+    weights = shipped_weights()
+    return Contender(
+        ExplorerRollout.name, False, lambda: ExplorerRollout(weights), model("explorer").config
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -77,16 +77,15 @@ def main(argv: list[str] | None = None) -> int:
     if ranges[0][0] < TRAIN_SEEDS.start or ranges[-1][1] > TRAIN_SEEDS.stop:
         parser.error(f"every seed set must lie in the training seeds, {TRAIN_SEEDS}")
     experiment = load_experiment("explorer")
-    shipped = shipped_weights()
+    names = feature_names(experiment.env_config())  # the same on every family
+    try:
+        directions = parse_directions(args.directions, names)
+    except ValueError as exc:
+        parser.error(str(exc))
+    weights = weight_vector(shipped_weights(), names, "the explorer's weights")
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
-        names = feature_names(cfg)
-        try:
-            directions = parse_directions(args.directions, names)
-        except ValueError as exc:
-            parser.error(str(exc))
-        weights = weight_vector(shipped, names, "the explorer's weights")
         for first in firsts:
             seeds = list(range(first, first + args.episodes))
             reference, _ = play_t99(cfg, seeds, weights)

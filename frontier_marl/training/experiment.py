@@ -165,9 +165,10 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
     if ppo:
         allowed = keyword_names(settings.algorithm)
-        if set(ppo) - allowed:
+        unknown = set(ppo) - allowed
+        if unknown:
             raise ValueError(
-                f"unknown or reserved [ppo] key(s) {sorted(set(ppo) - allowed)}{where}; "
+                f"unknown or reserved [ppo] key(s) {sorted(unknown)}{where}; "
                 f"allowed: {sorted(allowed)} (seed and device are set in [train])"
             )
         _check_ranges("ppo", ppo, where)
