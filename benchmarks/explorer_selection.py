@@ -10,7 +10,9 @@ validation seeds from ``--first`` (default 800,100) on, the same episodes for ev
         --models runs/explorer-ablation/tour-rule,runs/explorer-turn-best \\
         --json training/results/explorer/selection-turn.json
 
-Held-out seeds (900,000 and up) are never touched.
+``--heuristics`` names the heuristics to compare with (default nearest-path, the best on the
+coarse families; add cost-utility, the best on the fine grids). Held-out seeds (900,000 and
+up) are never touched.
 """
 
 from __future__ import annotations
@@ -29,12 +31,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--episodes", type=int, default=128, help="episodes per family")
     parser.add_argument("--first", type=int, default=VALIDATION_SEEDS.start + 100)
     parser.add_argument("--models", default="", help="comma-separated model folders or names")
+    parser.add_argument(
+        "--heuristics", default="nearest-path", help="comma-separated heuristics to compare with"
+    )
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if not VALIDATION_SEEDS.start <= args.first < VALIDATION_SEEDS.stop:
         parser.error(f"--first must be a validation seed, in {VALIDATION_SEEDS}")
-    names = ["nearest-path", "explorer", *[m for m in args.models.split(",") if m]]
+    heuristics = [h for h in args.heuristics.split(",") if h]
+    if not heuristics:
+        parser.error("--heuristics must name at least one heuristic")
+    names = [*heuristics, "explorer", *[m for m in args.models.split(",") if m]]
     seeds = range(args.first, VALIDATION_SEEDS.stop)
     rows = run_on_seeds(names, seeds, args.episodes, progress=not args.no_progress)
     print(format_table(rows))
@@ -43,7 +51,8 @@ def main(argv: list[str] | None = None) -> int:
         if row.get("vs_best"):
             means.setdefault(row["policy"], []).append(row["vs_best"]["mean"])
     for policy, values in means.items():
-        print(f"{policy}: mean T99 vs nearest-path {100 * sum(values) / len(values):+.2f} %")
+        mean = 100 * sum(values) / len(values)
+        print(f"{policy}: mean T99 vs each family's best heuristic {mean:+.2f} %")
     if args.json is not None:
         summary = [{k: v for k, v in row.items() if k != "per_episode"} for row in rows]
         command = {"episodes": args.episodes, "first_seed": args.first, "models": names}

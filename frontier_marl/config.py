@@ -27,7 +27,7 @@ from frontier_marl.checks import (
 
 CentroidEncoding = Literal["absolute", "relative", "distance", "none"]
 MapMode = Literal["static", "dynamic"]
-MapGenerator = Literal["random", "rooms"]
+MapGenerator = Literal["random", "rooms", "floorplan"]
 StartCells = Literal["largest-component", "any-free"]
 SensorModel = Literal["square", "raycast"]
 GainModel = Literal["size", "unknown"]
@@ -72,6 +72,8 @@ class ObservationConfig:
             one cell); ``None`` keeps the fixed 12 cells, whatever the sensor.
         fill: with ``features="explorer"``, one more feature per slot: the cluster's size over
             ``max_cluster_cells`` (:func:`frontier_marl.slot_features.cluster_fill`).
+        utility: with ``features="explorer"``, one more feature per slot: cost-utility's log
+            utility weighed by the sensor range (:func:`frontier_marl.slot_features.log_utility`).
     """
 
     centroid: CentroidEncoding = "absolute"
@@ -88,6 +90,7 @@ class ObservationConfig:
     unknown_near: bool = False
     near_ranges: float | None = None
     fill: bool = False
+    utility: bool = False
 
     def validate(self) -> None:
         check_choice("features", self.features, get_args(FeatureLayout))
@@ -104,9 +107,10 @@ class ObservationConfig:
             "turn",
             "unknown_near",
             "fill",
+            "utility",
         ):
             check_bool(name, getattr(self, name))
-        for name in ("tour", "turn", "unknown_near", "fill"):
+        for name in ("tour", "turn", "unknown_near", "fill", "utility"):
             if getattr(self, name) and self.features != "explorer":
                 raise ValueError(
                     f"{name}=True needs features='explorer' (it is a per-slot feature)"
@@ -221,8 +225,10 @@ class EnvConfig:
     Attributes:
         height, width: grid size in cells.
         n_agents: robots sharing one belief grid (1 = the thesis MDP).
-        map_generator: ``random`` (independent obstacles with ``obstacle_prob``) or ``rooms``
-            (rectangular rooms joined by corridors; ``obstacle_prob`` is not used).
+        map_generator: ``random`` (independent obstacles with ``obstacle_prob``), ``rooms``
+            (rectangular rooms joined by corridors) or ``floorplan`` (a building that fills
+            the grid, split into rooms by thin walls with doors); ``obstacle_prob`` is used by
+            ``random`` only.
         obstacle_prob: probability that a cell is an obstacle (open choice; 0.1 by
             calibration against the thesis's 20x20 baselines, docs/calibration.md).
         obstacle_prob_spread: draw each dynamic random layout's obstacle probability
@@ -296,10 +302,10 @@ class EnvConfig:
                 f"got {self.height}x{self.width}"
             )
         layout = (self.height // self.map_scale, self.width // self.map_scale)
-        if self.map_generator == "rooms" and min(layout) < 5:
+        if self.map_generator != "random" and min(layout) < 5:
             raise ValueError(
-                "map_generator='rooms' needs a layout of at least 5x5 cells (height and width "
-                f"/ map_scale), got {layout[0]}x{layout[1]}"
+                f"map_generator={self.map_generator!r} needs a layout of at least 5x5 cells "
+                f"(height and width / map_scale), got {layout[0]}x{layout[1]}"
             )
         check_choice("map_mode", self.map_mode, get_args(MapMode))
         check_int("map_seed", self.map_seed, 0)

@@ -11,6 +11,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.map_files import load_map
 from frontier_marl.core.maps import (
+    floorplan_map,
     largest_free_component,
     random_obstacle_map,
     rooms_map,
@@ -60,6 +61,8 @@ class EpisodeSource:
         height, width = cfg.height // scale, cfg.width // scale
         if cfg.map_generator == "rooms":
             layout = rooms_map(height, width, rng)
+        elif cfg.map_generator == "floorplan":
+            layout = floorplan_map(height, width, rng)
         else:
             density = cfg.obstacle_prob
             if cfg.obstacle_prob_spread > 0 and cfg.map_mode == "dynamic":

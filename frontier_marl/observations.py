@@ -31,6 +31,7 @@ from frontier_marl.slot_features import (
     cluster_fill,
     explorer_features,
     explorer_space,
+    log_utility,
     near_half_side,
     slot_feature_names,
     team_features,
@@ -57,7 +58,7 @@ class ObservationEncoder:
         self.features = obs.features
         if self.features == "explorer":
             self.tour, self.turn, self.unknown_near = obs.tour, obs.turn, obs.unknown_near
-            self.fill = obs.fill
+            self.fill, self.utility = obs.fill, obs.utility
             self.near = near_half_side(obs.near_ranges, cfg.perception_range)
             self.features_per_slot = len(slot_feature_names(obs))
             self.space: spaces.Space[Any] = explorer_space(self.n_slots, self.features_per_slot)
@@ -170,6 +171,8 @@ class ObservationEncoder:
                 parts.append(unknown_near(slots, beliefs, self.near))
             if self.fill:
                 parts.append(cluster_fill(slots, self.cfg.max_cluster_cells))
+            if self.utility:
+                parts.append(log_utility(slots, self.cfg.perception_range))
             if self.teammates != "none":
                 if teammates is None:
                     raise ValueError("this layout observes teammates: pass their rows")
@@ -246,6 +249,7 @@ def describe_layout(cfg: EnvConfig) -> dict[str, Any]:
             "unknown_near": cfg.observation.unknown_near,
             "near_ranges": cfg.observation.near_ranges,
             "fill": cfg.observation.fill,
+            **({"utility": True} if cfg.observation.utility else {}),
             "n_agents": None,
             "n_slots": enc.n_slots,
             "features_per_slot": enc.features_per_slot,

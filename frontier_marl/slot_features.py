@@ -45,6 +45,13 @@ With ``fill=True``, one more (:data:`FILL_FEATURE`), after those:
                 grid of the same floor plan (where the sensor and the pieces span more cells
                 and shadows leave more specks) (:func:`cluster_fill`)
 
+With ``utility=True``, one more (:data:`UTILITY_FEATURE`), after those:
+
+``utility``     cost-utility's log utility, ``log(1 + gain) - log(1 + path)`` (lengths in
+                cells), weighed by ``(r / UTILITY_RANGE) ** 4`` (:func:`log_utility`): about
+                nothing at the coarse grids' r = 3-5 and dominant at the floor plans' r = 35,
+                where the gain behind a frontier tells whole rooms from shadows
+
 With teammates observed (``teammates`` other than ``none``), three more per slot
 (:data:`TEAM_FEATURES`), whatever the team's size:
 
@@ -77,6 +84,8 @@ TOUR_FEATURE = "tour"
 TURN_FEATURE = "turn"
 UNKNOWN_NEAR_FEATURE = "unknown_near"
 FILL_FEATURE = "fill"
+UTILITY_FEATURE = "utility"
+UTILITY_RANGE = 12.0  # the sensor range, in cells, at which the utility feature weighs 1
 NEAR = 12  # the half-side of unknown_near's square, in cells
 TEAM_FEATURES = ("mate_distance", "mate_heading", "mate_target_distance")
 FAR = 2.0  # mate_target_distance when no teammate target is nearer (in CELLS units)
@@ -91,6 +100,7 @@ def slot_feature_names(observation: ObservationConfig) -> list[str]:
     names += [TURN_FEATURE] if observation.turn else []
     names += [UNKNOWN_NEAR_FEATURE] if observation.unknown_near else []
     names += [FILL_FEATURE] if observation.fill else []
+    names += [UTILITY_FEATURE] if observation.utility else []
     return names + (list(TEAM_FEATURES) if observation.teammates != "none" else [])
 
 
@@ -241,6 +251,15 @@ def cluster_fill(slots: SlotArrays, max_cluster_cells: int) -> np.ndarray:
     ``max_cluster_cells`` (0 on padding slots)."""
     fill = np.where(slots.valid, slots.size / max_cluster_cells, 0.0)
     return fill.astype(np.float32)[..., None]
+
+
+def log_utility(slots: SlotArrays, perception_range: int) -> np.ndarray:
+    """(M, n_slots, 1) :data:`UTILITY_FEATURE` of M robots: ``(log(1 + gain) - log(1 +
+    path length)) * (perception_range / UTILITY_RANGE) ** 4`` per slot (0 on padding slots)."""
+    path = np.where(slots.valid, slots.path_length, 0)
+    utility = np.log1p(np.where(slots.valid, slots.gain, 0)) - np.log1p(path)
+    weight = (perception_range / UTILITY_RANGE) ** 4
+    return np.where(slots.valid, weight * utility, 0.0).astype(np.float32)[..., None]
 
 
 def team_features(slots: SlotArrays, teammates: np.ndarray) -> np.ndarray:

@@ -153,7 +153,7 @@ def test_teams_are_also_compared_by_makespan():
 
 def test_families_and_seed_ranges():
     assert list(map_families.FAMILIES) == [
-        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine"
+        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine", "floorplan-96"
     ]  # fmt: skip
     for fam in map_families.FAMILIES.values():
         held = set(fam.heldout)
@@ -171,6 +171,7 @@ def test_families_and_seed_ranges():
         "rooms-32": (32, 32, 1, 3, "rooms", "dynamic"),
         "rooms-64": (64, 64, 1, 5, "rooms", "dynamic"),
         "rooms-96-fine": (96, 96, 3, 13, "rooms", "dynamic"),
+        "floorplan-96": (96, 96, 2, 13, "floorplan", "dynamic"),
     }
     (cfg,) = map_families.variant_configs(
         map_families.family("rooms-64"), {"perception_range": 4}, agents=2

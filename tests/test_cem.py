@@ -159,12 +159,14 @@ def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_pat
     script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_selection.py"
     selection = runpy.run_path(str(script))["main"]
     out = tmp_path / "selection.json"
-    assert selection(["--episodes", "1", "--json", str(out), "--no-progress"]) == 0
+    argv = ["--episodes", "1", "--heuristics", "nearest-path,cost-utility", "--json", str(out)]
+    assert selection([*argv, "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert {row["policy"] for row in rows} == {"nearest-path", "explorer"}
+    assert {row["policy"] for row in rows} == {"nearest-path", "cost-utility", "explorer"}
     assert all(row["seeds"] == [800_100] for row in rows)
-    with pytest.raises(SystemExit):
-        selection(["--first", "900000"])  # a held-out seed
+    for bad in (["--first", "900000"], ["--heuristics", ""]):  # a held-out seed; no heuristic
+        with pytest.raises(SystemExit):
+            selection(bad)
 
 
 def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) -> None:

@@ -229,7 +229,7 @@ def test_train_the_explorer_on_families_and_benchmark_it(tmp_path: Path, capsys)
     assert code == 0
     rows = json.loads(out.read_text())["rows"]
     assert {row["family"] for row in rows if row["policy"] == "explorer"} == {
-        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine"
+        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine", "floorplan-96"
     }  # fmt: skip
     assert all(row["seeds"][0] == 800_000 for row in rows)
 

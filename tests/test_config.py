@@ -76,6 +76,8 @@ BAD_VALUES = [
     ("turn", 1, "turn"),
     ("unknown_near", "yes", "unknown_near"),
     ("fill", 1, "fill"),
+    ("utility", 1, "utility"),
+    ("utility", True, "utility"),  # needs features="explorer"
     ("near_ranges", -1.0, "near_ranges"),
     ("explore_threshold", 0, "explore_threshold"),
     ("explore_threshold", 0.0, "explore_threshold"),

@@ -15,8 +15,10 @@ from frontier_marl.rewards import StepEvents, step_outcome
 from frontier_marl.slot_features import (
     CELLS,
     EXPLORER_FEATURES,
+    UTILITY_RANGE,
     cluster_fill,
     explorer_features,
+    log_utility,
     slot_feature_names,
     tour_lengths,
     turn_costs,
@@ -232,6 +234,34 @@ def test_the_fill_feature_is_the_size_over_the_split_size_on_a_finer_grid() -> N
         observations, *_ = env.step({"robot_0": action})
     with pytest.raises(ValueError, match="fill=True needs features='explorer'"):
         make_config("thesis-20x20", fill=True)
+
+
+def test_log_utility_on_a_hand_made_table() -> None:
+    table = _table([(0, 4), (3, 0)], [6, 3])  # gain 10 on both live slots
+    utility = log_utility(SlotArrays.stack([table]), perception_range=24)
+    weight = (24 / UTILITY_RANGE) ** 4  # 16
+    expected = [weight * np.log(11 / 7), weight * np.log(11 / 4), 0.0, 0.0]
+    assert utility.shape == (1, 4, 1)
+    assert utility[0, :, 0].tolist() == pytest.approx(expected, rel=1e-6)
+    # at r = 3 the same utility weighs (3 / 12) ** 4 = 1 / 256
+    coarse = log_utility(SlotArrays.stack([table]), perception_range=3)[0, :, 0]
+    assert coarse[:2] == pytest.approx(np.array(expected[:2]) / 16 / 256, rel=1e-6)
+
+
+def test_the_utility_feature_in_the_observation() -> None:
+    env = frontier_marl.parallel_env(**EXPLORER, fill=True, utility=True, perception_range=5)
+    names = slot_feature_names(env.config.observation)
+    assert names[-2:] == ["fill", "utility"]
+    observations, _ = env.reset(seed=3)
+    for _ in range(6):
+        table = SlotArrays.stack([env.mdp.slot_tables()[0]])
+        slots = observations["robot_0"]["slots"]
+        assert np.array_equal(slots[:, -1], log_utility(table, 5)[0, :, 0])
+        assert np.isfinite(slots).all()
+        action = int(np.flatnonzero(observations["robot_0"]["action_mask"])[0])
+        observations, *_ = env.step({"robot_0": action})
+    with pytest.raises(ValueError, match="utility=True needs features='explorer'"):
+        make_config("thesis-20x20", utility=True)
 
 
 def test_slot_feature_names_follow_the_encoders_columns() -> None:

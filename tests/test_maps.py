@@ -7,12 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import ndimage
 
 import frontier_marl
 from frontier_marl.config import make_config
 from frontier_marl.core.map_files import format_text_map, load_map, parse_pgm, parse_text_map
-from frontier_marl.core.maps import FOUR_CONNECTED, rooms_map
+from frontier_marl.core.maps import FOUR_CONNECTED, floorplan_map, rooms_map
 from frontier_marl.example_maps import (
     EXAMPLE_MAPS,
     example_map_names,
@@ -74,6 +76,62 @@ def test_rooms_map_rejects_tiny_grids():
         rooms_map(4, 10, np.random.default_rng(0))
     with pytest.raises(ValueError, match="map_generator"):
         make_config(map_generator="rooms", height=4, width=10)
+
+
+# ----------------------------------------------------------------- floor-plan generator
+
+
+@given(
+    height=st.integers(5, 90), width=st.integers(5, 90), seed=st.integers(0, 2**32 - 1),
+    min_room=st.integers(2, 9),
+)  # fmt: skip
+@settings(max_examples=150, deadline=None)
+def test_floorplan_map_is_one_building_of_thin_walls(height, width, seed, min_room):
+    grid = floorplan_map(height, width, np.random.default_rng(seed), min_room=min_room, door=2)
+    assert grid.shape == (height, width) and grid.dtype == bool
+    assert free_components(grid) == 1, "every room is reachable through doors"
+    border = np.concatenate([grid[0], grid[-1], grid[:, 0], grid[:, -1]])
+    assert border.all()
+    # thin walls: no 2x2 block of wall anywhere, so no solid rock between rooms
+    blocks = grid[:-1, :-1] & grid[1:, :-1] & grid[:-1, 1:] & grid[1:, 1:]
+    assert not blocks.any()
+
+
+def test_floorplan_map_splits_large_buildings_into_rooms_no_larger_than_max_room():
+    grid = floorplan_map(48, 48, np.random.default_rng(0), min_room=7, max_room=16)
+    interior = ~grid[1:-1, 1:-1]
+    assert interior.mean() > 0.85  # a building, not rooms carved out of rock
+    # a free square wider than max_room cannot fit inside one room; doors are 3 cells wide
+    open_square = ndimage.binary_erosion(~grid, structure=np.ones((17, 17), bool))
+    assert not open_square.any()
+    assert np.array_equal(grid, floorplan_map(48, 48, np.random.default_rng(0), min_room=7))
+    assert not np.array_equal(grid, floorplan_map(48, 48, np.random.default_rng(1)))
+
+
+def test_floorplan_map_rejects_bad_arguments():
+    rng = np.random.default_rng(0)
+    for kwargs, match in (
+        ({"height": 4}, "5x5"),
+        ({"min_room": 1}, "min_room"),
+        ({"door": 8}, "door"),
+        ({"max_room": 10}, "max_room"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            floorplan_map(**{"height": 40, "width": 40, "rng": rng, **kwargs})
+    with pytest.raises(ValueError, match="map_generator='floorplan'"):
+        make_config(map_generator="floorplan", height=8, width=8, map_scale=2)
+
+
+def test_env_with_the_floorplan_generator_is_deterministic():
+    kwargs = {"map_generator": "floorplan", "height": 48, "width": 48, "map_scale": 2}
+    first = frontier_marl.parallel_env(**kwargs, map_mode="dynamic", perception_range=6)
+    again = frontier_marl.parallel_env(**kwargs, map_mode="dynamic", perception_range=6)
+    first.reset(seed=4)
+    again.reset(seed=4)
+    assert np.array_equal(first.world.true_grid, again.world.true_grid)
+    grid = first.world.true_grid
+    assert np.array_equal(grid, grid[::2, ::2].repeat(2, axis=0).repeat(2, axis=1))  # 2x2 blocks
+    assert grid.mean() < 0.3
 
 
 def test_env_with_the_rooms_generator_static_and_dynamic():

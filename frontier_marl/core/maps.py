@@ -122,3 +122,90 @@ def _carve_corridor(
             max(top, 1) : min(bottom + corridor_width, height - 1),
             max(left, 1) : min(right + corridor_width, width - 1),
         ] = False
+
+
+def floorplan_map(
+    height: int,
+    width: int,
+    rng: np.random.Generator,
+    min_room: int = 7,
+    max_room: int | None = None,
+    door: int = 3,
+) -> np.ndarray:
+    """A building that fills the grid: thin walls split it recursively into rooms, each wall
+    with a door (two on long walls), as on real floor plans (no solid rock between rooms).
+
+    A rectangle whose longer side exceeds ``max_room`` is split across that side by a wall one
+    cell thick, at a random place that leaves rooms of at least ``min_room`` cells on both
+    sides and does not end in a door of an earlier wall; the door (``door`` cells wide) is
+    placed at random along the new wall. Every free cell is reachable from every other.
+    Returns a bool grid, True = occupied (walls).
+    """
+    if height < 5 or width < 5:
+        raise ValueError(f"floorplan_map needs at least 5x5 cells, got {height}x{width}")
+    if min_room < 2:
+        raise ValueError(f"min_room must be >= 2, got {min_room}")
+    if door < 1 or door > min_room:
+        raise ValueError(f"door must be in [1, min_room={min_room}], got {door}")
+    if max_room is None:
+        max_room = max(2 * min_room + 1, min(height, width) // 3)
+    if max_room < 2 * min_room + 1:
+        raise ValueError(
+            f"max_room must be >= 2 * min_room + 1 = {2 * min_room + 1}, got {max_room}"
+        )
+    grid = np.zeros((height, width), dtype=bool)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = True
+    pending = [(1, 1, height - 1, width - 1)]  # rooms: top, left, bottom (excl.), right (excl.)
+    while pending:
+        top, left, bottom, right = pending.pop()
+        rows, cols = bottom - top, right - left
+        across_rows = rows > cols or (rows == cols and rng.random() < 0.5)
+        span = rows if across_rows else cols
+        if span <= max_room:
+            continue
+        wall = _place_wall(grid, (top, left, bottom, right), across_rows, min_room, rng)
+        if wall is None:
+            continue
+        if across_rows:
+            grid[wall, left:right] = True
+            _carve_doors(grid[wall, left:right], door, rng)
+            pending += [(top, left, wall, right), (wall + 1, left, bottom, right)]
+        else:
+            grid[top:bottom, wall] = True
+            _carve_doors(grid[top:bottom, wall], door, rng)
+            pending += [(top, left, bottom, wall), (top, wall + 1, bottom, right)]
+    return grid
+
+
+def _place_wall(
+    grid: np.ndarray,
+    room: tuple[int, int, int, int],
+    across_rows: bool,
+    min_room: int,
+    rng: np.random.Generator,
+) -> int | None:
+    """Row (or column) of a wall that splits ``room`` into two rooms of at least ``min_room``
+    cells and whose two ends meet walls, not doors; ``None`` when 20 draws found none."""
+    top, left, bottom, right = room
+    low, high = (top, bottom) if across_rows else (left, right)
+    if high - low < 2 * min_room + 1:
+        return None
+    for _ in range(20):
+        line = int(rng.integers(low + min_room, high - min_room))
+        if across_rows:
+            ends = grid[line, left - 1], grid[line, right]
+        else:
+            ends = grid[top - 1, line], grid[bottom, line]
+        if all(ends):
+            return line
+    return None
+
+
+def _carve_doors(wall: np.ndarray, door: int, rng: np.random.Generator) -> None:
+    """Open a door of ``door`` cells in ``wall`` (a view of the new wall's cells), and a second
+    one in the other half of a wall longer than six doors."""
+    length = len(wall)
+    halves = [(0, length)] if length <= 6 * door else [(0, length // 2), (length // 2, length)]
+    for start, stop in halves:
+        at = int(rng.integers(start, max(start + 1, stop - door + 1)))
+        wall[at : at + door] = False

@@ -86,9 +86,12 @@ def _family(name: str, description: str, **env: Any) -> MapFamily:
 #: average: each layout's density drawn from U(0, 0.3)), rooms and corridors at two sizes, and
 #: rooms-32 layouts on a 3x finer grid: walls and doors 3 cells thick and a sensor that spans
 #: 13 cells, as on real floor plans at 0.1 m a cell (the Explore-Bench regime), where the
-#: frontier breaks into long pieces and the specks that shadows leave.
+#: frontier breaks into long pieces and the specks that shadows leave. ``floorplan-96``: whole
+#: buildings split into rooms by thin walls with doors (no solid rock between rooms), drawn on
+#: a 48x48 layout at map_scale 2, with the same sensor: the Explore-Bench floor plans' regime.
 _ROOMS_64 = {"height": 64, "width": 64, "perception_range": 5}
 _ROOMS_96_FINE = {"height": 96, "width": 96, "map_scale": 3, "perception_range": 13}
+_FLOORPLAN_96 = {"height": 96, "width": 96, "map_scale": 2, "perception_range": 13}
 FAMILIES: dict[str, MapFamily] = {
     f.name: f
     for f in (
@@ -101,6 +104,13 @@ FAMILIES: dict[str, MapFamily] = {
             "96x96 rooms and corridors on a 3x finer grid (map_scale = 3), r = 13",
             preset="rooms-32",
             **_ROOMS_96_FINE,
+        ),
+        _family(
+            "floorplan-96",
+            "96x96 buildings split into rooms by thin walls with doors (map_scale = 2), r = 13",
+            preset="rooms-32",
+            map_generator="floorplan",
+            **_FLOORPLAN_96,
         ),
     )
 }
