@@ -354,8 +354,14 @@ def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
         (2, 9, "cost-utility"), (2, 9, "nearest-path"),
     ]  # fmt: skip
     assert all(row["success"] == 1 for row in rows)
-    with pytest.raises(SystemExit):
-        sweep(["--scales", "x"])
+    argv = ["--layouts", "floorplan", "--scales", "1", "--episodes", "1", "--first", "800500"]
+    assert sweep([*argv, "--policies", "nearest-path", "--json", str(out)]) == 0
+    (row,) = json.loads(out.read_text())["rows"]
+    assert (row["scale"], row["perception_range"], row["success"]) == (1, 6, 1)
+    assert json.loads(out.read_text())["options"]["first_seed"] == 800_500
+    for bad in (["--scales", "x"], ["--first", "900000"], ["--layouts", "caves"]):
+        with pytest.raises(SystemExit):
+            sweep(bad)
 
 
 def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
