@@ -212,7 +212,7 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
     assert probe["main"](argv) == 0
     rows = json.loads(out.read_text())["rows"]
     assert [row["family"] for row in rows] == [
-        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine"
+        "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine", "floorplan-96"
     ]  # fmt: skip
     assert all(set(row) == {"family", "rule", "R8 W-0.4"} for row in rows)
     for bad in (["--first", "800000"], ["--radii", "a"]):
@@ -234,7 +234,7 @@ def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_p
     argv = ["--directions", "tour:1,lengths:3", "--seed-sets", "730000,731000", "--episodes", "2"]
     assert sensitivity["main"]([*argv, "--json", str(out)]) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert len(rows) == 5 * 2 * 2  # families x seed sets x directions
+    assert len(rows) == 6 * 2 * 2  # families x seed sets x directions
     unchanged = [row for row in rows if row["direction"] == "tour:1"]
     assert all(row["change"] == 0.0 for row in unchanged)  # the same weights, the same episodes
     assert {row["first_seed"] for row in rows} == {730000, 731000}
@@ -274,7 +274,7 @@ def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_
     argv = ["--weights=0,0.1", "--kinds", "true", "--episodes", "2", "--json", str(out)]
     assert probe["main"](argv) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert len(rows) == 5 * 2
+    assert len(rows) == 6 * 2  # families x weights
     assert all(row["change"] == 0.0 for row in rows if row["weight"] == 0)
     for bad in (
         ["--first", "900000"],
