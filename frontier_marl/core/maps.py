@@ -184,12 +184,11 @@ def _place_wall(
     min_room: int,
     rng: np.random.Generator,
 ) -> int | None:
-    """Row (or column) of a wall that splits ``room`` into two rooms of at least ``min_room``
-    cells and whose two ends meet walls, not doors; ``None`` when 20 draws found none."""
+    """Row (or column) of a wall that splits ``room`` (longer than ``2 * min_room + 1`` across
+    the wall) into two rooms of at least ``min_room`` cells and whose two ends meet walls, not
+    doors; ``None`` when 20 draws found none."""
     top, left, bottom, right = room
     low, high = (top, bottom) if across_rows else (left, right)
-    if high - low < 2 * min_room + 1:
-        return None
     for _ in range(20):
         line = int(rng.integers(low + min_room, high - min_room))
         if across_rows:
