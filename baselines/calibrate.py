@@ -57,8 +57,9 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.evaluation import evaluate, make_policy
-from frontier_marl.thesis import HEURISTIC_BASELINES
+from frontier_marl.config.thesis import HEURISTIC_BASELINES
+from frontier_marl.evaluation import evaluate
+from frontier_marl.policies import make_policy
 
 THESIS = {
     policy: figure

@@ -16,8 +16,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.evaluation import evaluate, make_policy
-from frontier_marl.progress import progress_bar
+from frontier_marl.evaluation import evaluate
+from frontier_marl.policies import make_policy
+from frontier_marl.utils.progress import progress_bar
 
 #: candidate name -> env keywords (on top of each preset; ``obstacle_prob_spread`` is given
 #: explicitly everywhere so the table does not depend on the package's current default).

@@ -22,9 +22,9 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.commands.arguments import parse_set_options
-from frontier_marl.evaluation import make_policy
-from frontier_marl.progress import progress_bar
+from frontier_marl.cli.arguments import parse_set_options
+from frontier_marl.policies import make_policy
+from frontier_marl.utils.progress import progress_bar
 
 STUCK = ("no_progress", "step_limit")
 
@@ -111,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     env_kwargs: dict[str, Any] = {"preset": args.preset, "map_mode": args.map_mode}
     if args.map is not None:
-        from frontier_marl.example_maps import resolve_map
+        from frontier_marl.core.example_maps import resolve_map
 
         env_kwargs = {"preset": args.preset, "map_path": resolve_map(args.map)}
     env_kwargs.update(parse_set_options(args.overrides))

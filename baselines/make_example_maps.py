@@ -4,7 +4,7 @@
     python baselines/make_example_maps.py --check    # exit 1 if a file differs
 
 Each map is :func:`frontier_marl.core.maps.rooms_map` (height, width, seed) as listed in
-:data:`frontier_marl.example_maps.EXAMPLE_MAPS`, written with ``format_text_map``.
+:data:`frontier_marl.core.example_maps.EXAMPLE_MAPS`, written with ``format_text_map``.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
+from frontier_marl.core.example_maps import EXAMPLE_MAPS, generate_example_map
 from frontier_marl.core.map_files import format_text_map
 from frontier_marl.core.maps import FOUR_CONNECTED
-from frontier_marl.example_maps import EXAMPLE_MAPS, generate_example_map
 
 OUT = Path(__file__).resolve().parents[1] / "frontier_marl" / "assets" / "maps"
 

@@ -45,10 +45,11 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.evaluation import Policy, evaluate, make_policy
+from frontier_marl.core.example_maps import example_map_path
+from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.plots import plot_team_comparison, team_value
-from frontier_marl.example_maps import example_map_path
-from frontier_marl.workflows.baselines import dumps_rows
+from frontier_marl.experiments.baselines import dumps_rows
+from frontier_marl.policies import Policy, make_policy
 
 OUT = Path(__file__).resolve().parent / "results" / "multi_robot"
 HEURISTICS = ("greedy-distance", "coordinated-assignment", "utility-discount")
@@ -109,8 +110,8 @@ def dqn_factory(run: Path, setting_kwargs: Mapping[str, Any], robots: Sequence[i
     """A zero-argument factory of the deterministic ``dqn-shared`` policy of run folder ``run``,
     after checking that the model fits the setting's env with every team size."""
     from frontier_marl.config import make_config
-    from frontier_marl.evaluation import ModelPolicy
-    from frontier_marl.training.evaluate_model import check_model_env, load_model
+    from frontier_marl.policies import ModelPolicy
+    from frontier_marl.policies.models import check_model_env, load_model
 
     loaded = load_model(run)
     for n in robots:

@@ -18,8 +18,8 @@ import sys
 import time
 from pathlib import Path
 
-from frontier_marl.cli import main as cli_main
-from frontier_marl.workflows.baselines import (
+from frontier_marl.cli.main import main as cli_main
+from frontier_marl.experiments.baselines import (
     DEFAULT_POLICIES,
     dumps_rows,
     format_table,

@@ -20,7 +20,7 @@ from typing import Any
 
 import frontier_marl
 from frontier_marl.config import config_to_dict
-from frontier_marl.evaluation.families import family, variant_configs
+from frontier_marl.evaluation.benchmark.families import family, variant_configs
 
 _BENCH_VECTOR_ENV = runpy.run_path(str(Path(__file__).with_name("bench_vector_env.py")))
 

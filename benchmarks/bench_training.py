@@ -53,9 +53,9 @@ class Timer:
 
 def stage_functions() -> list[tuple[object, str]]:
     """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
-    from frontier_marl import engine
     from frontier_marl.core import world
     from frontier_marl.envs import parallel
+    from frontier_marl.sim import engine
 
     return [
         (world.World, "move"),  # planning, walking, sensing

@@ -26,7 +26,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from frontier_marl.cli import main as cli
+from frontier_marl.cli.main import main as cli
 from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
 

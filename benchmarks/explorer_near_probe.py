@@ -1,7 +1,7 @@
 """How the tour rule gains from the ``unknown_near`` feature, by square size and weight.
 
 The rule "path -1, tour -0.5" plus ``W * unknown_near`` computed over a square of half-side
-``R`` cells (the env's feature uses R = :data:`~frontier_marl.slot_features.NEAR`), for every
+``R`` cells (the env's feature uses R = :data:`~frontier_marl.sim.features.NEAR`), for every
 R of ``--radii`` and W of ``--weights``, against the path-only scorer (nearest-path among the
 slots) on the same training episodes of every family, played as CEM plays them (the
 ``explorer`` config's episodes; seeds from ``--first``, training seeds only)::
@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from frontier_marl.envs.vector import FrontierVectorEnv
-from frontier_marl.evaluation.families import TRAIN_SEEDS
-from frontier_marl.slot_features import unknown_near
+from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
+from frontier_marl.sim.features import unknown_near
 from frontier_marl.training.cem import feature_names, play_scorer, relative_t99, weight_vector
 from frontier_marl.training.experiment import load_experiment
 

@@ -23,16 +23,16 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.evaluation.benchmark import Contender, contenders, model, run_benchmark
-from frontier_marl.evaluation.benchmark_stats import format_table
-from frontier_marl.evaluation.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.lookahead import LookaheadOracle
-from frontier_marl.observations import ObservationEncoder
+from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, model, run_benchmark
+from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.lookahead import LookaheadOracle
+from frontier_marl.sim.observations import ObservationEncoder
 from frontier_marl.training.cem import feature_names, shipped_weights, weight_vector
 
 
 class LinearScorerBase:
-    """A rollout base policy (:class:`~frontier_marl.evaluation.lookahead.RolloutBase`): the
+    """A rollout base policy (:class:`~frontier_marl.policies.lookahead.RolloutBase`): the
     linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own; the
     simulations keep no heading, so the ``current`` feature reads 0)."""
 

@@ -21,9 +21,9 @@ import argparse
 import json
 from pathlib import Path
 
-from frontier_marl.evaluation.benchmark import run_on_seeds
-from frontier_marl.evaluation.benchmark_stats import format_table
-from frontier_marl.evaluation.families import VALIDATION_SEEDS
+from frontier_marl.evaluation.benchmark.families import VALIDATION_SEEDS
+from frontier_marl.evaluation.benchmark.run import run_on_seeds
+from frontier_marl.evaluation.benchmark.stats import format_table
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,9 +15,9 @@ import argparse
 import json
 from pathlib import Path
 
-from frontier_marl.evaluation.benchmark import run_on_seeds
-from frontier_marl.evaluation.benchmark_stats import format_table
-from frontier_marl.evaluation.families import TRAIN_SEEDS
+from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
+from frontier_marl.evaluation.benchmark.run import run_on_seeds
+from frontier_marl.evaluation.benchmark.stats import format_table
 from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
 

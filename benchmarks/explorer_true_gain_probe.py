@@ -28,7 +28,7 @@ import numpy as np
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.sensing import reveal
 from frontier_marl.envs.vector import FrontierVectorEnv
-from frontier_marl.evaluation.families import TRAIN_SEEDS
+from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
 from frontier_marl.training.cem import (
     changes_text,
     feature_names,

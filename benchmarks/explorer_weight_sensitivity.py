@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from frontier_marl.evaluation.families import TRAIN_SEEDS
+from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
 from frontier_marl.training.cem import (
     changes_text,
     feature_names,

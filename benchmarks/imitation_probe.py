@@ -27,12 +27,12 @@ import time
 import numpy as np
 import torch as th
 
-from frontier_marl.evaluation.families import family
+from frontier_marl.evaluation.benchmark.families import family
+from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
 from frontier_marl.training.batched_vec_env import make_batched_vec_env
 from frontier_marl.training.experiment import load_experiment
 from frontier_marl.training.family_validation import FamilyValidator
 from frontier_marl.training.imitation import Dataset, collect, fit
-from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
 
 EPISODES = {"random-20": 12, "random-30": 8, "rooms-32": 12, "rooms-64": 3}  # per round
 

@@ -24,8 +24,8 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
-from frontier_marl.evaluation.benchmark import contenders, run_benchmark
-from frontier_marl.evaluation.families import VALIDATION_SEEDS, family
+from frontier_marl.evaluation.benchmark.families import VALIDATION_SEEDS, family
+from frontier_marl.evaluation.benchmark.run import contenders, run_benchmark
 
 #: layouts: (family, layout side in cells, sensor range per scale step)
 LAYOUTS = {"rooms": ("rooms-32", 32, 13 / 3), "floorplan": ("floorplan-96", 48, 13 / 2)}

@@ -16,8 +16,8 @@ from typing import Any
 
 from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
 from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
+from frontier_marl.envs.registration import GYM_ID, PETTINGZOO_ID, register_envs
 from frontier_marl.envs.vector import FrontierVectorEnv, vector_env
-from frontier_marl.registration import GYM_ID, PETTINGZOO_ID, register_envs
 
 __version__ = "0.1.0"
 

@@ -1,5 +1,5 @@
 import sys
 
-from frontier_marl.cli import main
+from frontier_marl.cli.main import main
 
 sys.exit(main())

@@ -16,7 +16,7 @@ import frontier_marl
 from frontier_marl import FrontierExploreEnv
 from frontier_marl.config import PRESETS as PRESET_TABLE
 from frontier_marl.config import make_config
-from frontier_marl.registration import VARIANTS, variant_id
+from frontier_marl.envs.registration import VARIANTS, variant_id
 
 PRESETS = tuple(PRESET_TABLE)
 MAP_MODES = ("static", "dynamic")

@@ -14,7 +14,7 @@ import frontier_marl
 from frontier_marl.config import PRESETS as PRESET_TABLE
 from frontier_marl.config import make_config
 from frontier_marl.envs.parallel import FrontierParallelEnv
-from frontier_marl.registration import VARIANTS, variant_id
+from frontier_marl.envs.registration import VARIANTS, variant_id
 
 matplotlib.use("Agg")
 

@@ -36,8 +36,8 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
 
 
 def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
-    from frontier_marl import engine
     from frontier_marl.core import world
+    from frontier_marl.sim import engine
 
     before = (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset)
     main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]

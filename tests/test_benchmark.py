@@ -12,19 +12,19 @@ import numpy as np
 import pytest
 
 import frontier_marl
-from frontier_marl.cli import main
+from frontier_marl.cli.main import main
 from frontier_marl.core.frontiers import cluster_frontiers
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.slots import robot_slots
-from frontier_marl.evaluation import GreedyDistance, NearestPath, make_policy
-from frontier_marl.evaluation import benchmark as bench
-from frontier_marl.evaluation import families as map_families
-from frontier_marl.evaluation.benchmark_stats import (
+from frontier_marl.evaluation.benchmark import families as map_families
+from frontier_marl.evaluation.benchmark import run as bench
+from frontier_marl.evaluation.benchmark.stats import (
     best_heuristic,
     compare,
     format_table,
     paired_difference,
 )
+from frontier_marl.policies import GreedyDistance, NearestPath, make_policy
 
 EXPLORE_BENCH = Path(__file__).resolve().parents[2] / "shared" / "maps" / "explore-bench"
 _CODES = {"?": UNKNOWN, ".": FREE, "#": OCCUPIED, "R": FREE}

@@ -17,7 +17,7 @@ import pytest
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("supersuit")
 
-from frontier_marl.cli import main  # noqa: E402
+from frontier_marl.cli.main import main  # noqa: E402
 
 CONFIGS = ("config01", "config04")
 
@@ -45,7 +45,7 @@ def test_missing_ray_exits_2_with_install_hint(
 
 
 def test_require_ray_raises_an_import_error(monkeypatch: pytest.MonkeyPatch) -> None:
-    from frontier_marl.workflows.ray_tune import RayNotInstalledError, require_ray
+    from frontier_marl.experiments.ray_tune import RayNotInstalledError, require_ray
 
     monkeypatch.setitem(sys.modules, "ray", None)
     with pytest.raises(RayNotInstalledError, match=r"frontier-marl\[ray\]"):
@@ -54,7 +54,7 @@ def test_require_ray_raises_an_import_error(monkeypatch: pytest.MonkeyPatch) -> 
 
 
 def test_build_grid_lists_configs_seeds_budgets(tmp_path: Path) -> None:
-    from frontier_marl.workflows.campaign import build_grid
+    from frontier_marl.experiments.campaign import build_grid
 
     trials = build_grid(
         CONFIGS,
@@ -142,7 +142,7 @@ def test_campaign_collects_one_row_per_trial(campaign: tuple[Path, list[str]]) -
 
 
 def test_campaign_table_matches_the_run_folders(campaign: tuple[Path, list[str]]) -> None:
-    from frontier_marl.workflows.results import collect_runs
+    from frontier_marl.experiments.results import collect_runs
 
     out, _args = campaign
     table = json.loads((out / "campaign.json").read_text())["rows"]
@@ -167,7 +167,7 @@ def test_campaign_rerun_reuses_finished_runs(campaign: tuple[Path, list[str]]) -
 def test_campaign_refuses_a_run_folder_of_another_experiment(
     campaign: tuple[Path, list[str]],
 ) -> None:
-    from frontier_marl.workflows.campaign import build_grid, run_trial
+    from frontier_marl.experiments.campaign import build_grid, run_trial
 
     out, _args = campaign
     changed = build_grid(

@@ -11,7 +11,7 @@ import pytest
 import torch
 
 from frontier_marl import FrontierParallelEnv
-from frontier_marl.cli import main
+from frontier_marl.cli.main import main
 from frontier_marl.training.cem import (
     CEMSettings,
     feature_names,
@@ -195,7 +195,7 @@ def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
 def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> None:
     import runpy
 
-    from frontier_marl.slot_features import NEAR
+    from frontier_marl.sim.features import NEAR
     from frontier_marl.training.cem import play_scorer, weight_vector
 
     script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_near_probe.py"

@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from frontier_marl.cli import main
-from frontier_marl.commands.arguments import parse_set_options, parse_value
+from frontier_marl.cli.arguments import parse_set_options, parse_value
+from frontier_marl.cli.main import main
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 SMALL = [

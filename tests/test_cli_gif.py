@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import frontier_marl
-from frontier_marl.cli import main
-from frontier_marl.commands.gif import record_episode, render_frame
+from frontier_marl.cli.commands.gif import record_episode, render_frame
+from frontier_marl.cli.main import main
 
 SMALL = {"height": 8, "width": 9, "perception_range": 2, "explore_threshold": 0.8}
 SMALL_ARGS = [arg for key, value in SMALL.items() for arg in ("--set", f"{key}={value}")]

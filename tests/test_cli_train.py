@@ -10,8 +10,8 @@ import pytest
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("supersuit")
 
-from frontier_marl.cli import main
-from frontier_marl.pretrained import pretrained_model_dir  # noqa: E402
+from frontier_marl.cli.main import main
+from frontier_marl.policies.models import pretrained_model_dir  # noqa: E402
 
 TINY_CONFIG = """
 name = "tiny-cli"

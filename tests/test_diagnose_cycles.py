@@ -5,7 +5,7 @@ from __future__ import annotations
 import runpy
 from pathlib import Path
 
-from frontier_marl.pretrained import pretrained_model_dir
+from frontier_marl.policies.models import pretrained_model_dir
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -14,7 +14,8 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def test_one_row_per_checkpoint_and_seed(tmp_path: Path) -> None:
-    from frontier_marl.training.evaluate_model import evaluate_model, load_model
+    from frontier_marl.evaluation.model_evaluation import evaluate_model
+    from frontier_marl.policies.models import load_model
     from frontier_marl.training.train import train
 
     experiment = experiment_from_dict(

@@ -9,11 +9,8 @@ import numpy as np
 import pytest
 
 import frontier_marl
-from frontier_marl.evaluation import (
-    CallablePolicy,
-    evaluate,
-    make_policy,
-)
+from frontier_marl.config.thesis import HEURISTIC_BASELINES, heuristic_baseline
+from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.metrics import (
     action_shares,
     cells_to_coverage,
@@ -23,7 +20,7 @@ from frontier_marl.evaluation.metrics import (
     overlap_ratio,
     resample_curve,
 )
-from frontier_marl.thesis import HEURISTIC_BASELINES, heuristic_baseline
+from frontier_marl.policies import CallablePolicy, make_policy
 
 # A tiny map. explore_threshold < 1 keeps episodes from running out of frontiers, which
 # currently crashes the env (see test_fully_known_map_gives_exact_numbers).

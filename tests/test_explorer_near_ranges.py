@@ -8,9 +8,9 @@ import pytest
 import frontier_marl
 from frontier_marl.config import make_config
 from frontier_marl.core.slots import SlotArrays
-from frontier_marl.observations import ObservationEncoder, describe_layout
-from frontier_marl.slot_features import NEAR, near_half_side, unknown_near
-from frontier_marl.training.metadata import ModelEnvMismatchError, check_compatible
+from frontier_marl.policies.metadata import ModelEnvMismatchError, check_compatible
+from frontier_marl.sim.features import NEAR, near_half_side, unknown_near
+from frontier_marl.sim.observations import ObservationEncoder, describe_layout
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown", "unknown_near": True}
 

@@ -10,9 +10,7 @@ import torch
 import frontier_marl
 from frontier_marl.config import make_config
 from frontier_marl.core.slots import SlotArrays, SlotTable
-from frontier_marl.motion import TRAIL_STEPS, MotionTrail
-from frontier_marl.rewards import StepEvents, step_outcome
-from frontier_marl.slot_features import (
+from frontier_marl.sim.features import (
     CELLS,
     EXPLORER_FEATURES,
     UTILITY_RANGE,
@@ -24,6 +22,8 @@ from frontier_marl.slot_features import (
     turn_costs,
     unknown_near,
 )
+from frontier_marl.sim.motion import TRAIL_STEPS, MotionTrail
+from frontier_marl.sim.rewards import StepEvents, step_outcome
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown"}
 
@@ -153,7 +153,7 @@ def test_the_turn_feature_follows_the_robots_own_steps() -> None:
 
 def test_unknown_near_on_a_hand_made_belief() -> None:
     from frontier_marl.core.grid import FREE, UNKNOWN
-    from frontier_marl.slot_features import NEAR
+    from frontier_marl.sim.features import NEAR
 
     side = 2 * NEAR + 1
     belief = np.full((40, 60), FREE, dtype=np.int8)
@@ -184,7 +184,7 @@ def test_unknown_near_reads_each_worlds_shared_belief_for_its_robots() -> None:
 
 def test_unknown_tables_match_numpys_summed_area_tables() -> None:
     from frontier_marl.core.grid import UNKNOWN
-    from frontier_marl.slot_features import unknown_tables
+    from frontier_marl.sim.features import unknown_tables
 
     for seed in range(5):
         rng = np.random.default_rng(seed)
@@ -280,7 +280,7 @@ def test_slot_feature_names_follow_the_encoders_columns() -> None:
 
 
 def test_team_features_on_a_hand_made_table() -> None:
-    from frontier_marl.slot_features import FAR, TEAM_FEATURES, team_features
+    from frontier_marl.sim.features import FAR, TEAM_FEATURES, team_features
 
     table = _table([(0, 4), (3, 0)], [6, 3])
     slots = SlotArrays.stack([table])
@@ -329,7 +329,7 @@ def test_commit_narrows_the_mask_to_the_previous_target_until_progress() -> None
 
 
 def test_heuristics_take_the_until_reached_rule() -> None:
-    from frontier_marl.evaluation import make_policy
+    from frontier_marl.policies import make_policy
 
     env = frontier_marl.parallel_env(preset="rooms-32", n_slots=16)
     for name in ("nearest-path", "coordinated-assignment"):
@@ -370,8 +370,8 @@ def test_batched_and_single_explorer_observations_agree() -> None:
 
 
 def _slot_model(n_envs: int = 2, attention_heads: int = 0):  # noqa: ANN202
+    from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
     from frontier_marl.training.batched_vec_env import make_batched_vec_env
-    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
 
     torch.set_num_threads(1)
     cfg = make_config("thesis-20x20", reward="travel", **EXPLORER)
@@ -402,7 +402,7 @@ def test_slot_q_network_is_permutation_equivariant_and_masks(attention_heads: in
 
 
 def test_attention_reaches_the_q_values_and_survives_save_and_load(tmp_path) -> None:
-    from frontier_marl.training.slot_policy import MaskedDQN
+    from frontier_marl.policies.networks.slot_dqn import MaskedDQN
 
     model, env = _slot_model(attention_heads=4)
     observation = env.reset()
@@ -422,7 +422,7 @@ def test_attention_reaches_the_q_values_and_survives_save_and_load(tmp_path) -> 
 
 @pytest.mark.parametrize("heads", [-1, 3, 1.5, True])
 def test_bad_attention_heads_are_refused(heads: object) -> None:
-    from frontier_marl.training.slot_policy import SlotScorer
+    from frontier_marl.policies.networks.slot_dqn import SlotScorer
 
     with pytest.raises(ValueError, match="attention_heads"):
         SlotScorer(6, 10, [16, 16], torch.nn.ReLU, heads)  # type: ignore[arg-type]
@@ -481,8 +481,8 @@ def test_the_shipped_explorer_acts_on_every_family_and_a_floor_plan_size(tmp_pat
     """`explorer` by name: one model for 20x20 to 64x64 (and a 128x128 example map)."""
     import json
 
-    from frontier_marl.cli import main
-    from frontier_marl.pretrained import pretrained_model_dir
+    from frontier_marl.cli.main import main
+    from frontier_marl.policies.models import pretrained_model_dir
 
     meta = json.loads((pretrained_model_dir("explorer") / "model.json").read_text())
     assert meta["observation_layout"]["features"] == "explorer"
@@ -501,7 +501,7 @@ def test_the_shipped_team_explorer_acts_for_teams_of_2_4_and_8(tmp_path) -> None
     """`team-explorer` by name: one model, every robot acting from its own observation."""
     import json
 
-    from frontier_marl.cli import main
+    from frontier_marl.cli.main import main
 
     for agents in (2, 4, 8):
         out = tmp_path / f"bench-{agents}.json"
@@ -521,8 +521,8 @@ def test_the_shipped_team_explorer_acts_for_teams_of_2_4_and_8(tmp_path) -> None
     ],
 )
 def test_bad_scorer_settings_are_refused(policy_kwargs: dict, message: str) -> None:
+    from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
     from frontier_marl.training.batched_vec_env import make_batched_vec_env
-    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
 
     env = make_batched_vec_env({"config": make_config("thesis-20x20", **EXPLORER)}, 1)
     with pytest.raises(ValueError, match=message):

@@ -9,7 +9,7 @@ import torch
 
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.world import World, WorldParams
-from frontier_marl.evaluation.lookahead import LookaheadOracle, lookahead_costs
+from frontier_marl.policies.lookahead import LookaheadOracle, lookahead_costs
 
 
 def _corridor() -> World:
@@ -48,8 +48,8 @@ def test_lookahead_costs_need_one_robot() -> None:
 
 
 def test_oracle_travels_less_than_nearest_path_on_validation_episodes() -> None:
-    from frontier_marl.evaluation.benchmark import contenders, run_family
-    from frontier_marl.evaluation.families import family, variant_configs
+    from frontier_marl.evaluation.benchmark.families import family, variant_configs
+    from frontier_marl.evaluation.benchmark.run import contenders, run_family
     from frontier_marl.evaluation.records import level_key
 
     fam = family("random-20")
@@ -63,9 +63,9 @@ def test_oracle_travels_less_than_nearest_path_on_validation_episodes() -> None:
 
 
 def test_oracle_is_never_the_best_heuristic_and_refuses_teams() -> None:
-    from frontier_marl.cli import main
-    from frontier_marl.evaluation.benchmark import contenders, run_benchmark
-    from frontier_marl.evaluation.families import family
+    from frontier_marl.cli.main import main
+    from frontier_marl.evaluation.benchmark.families import family
+    from frontier_marl.evaluation.benchmark.run import contenders, run_benchmark
 
     rows = run_benchmark(
         [family("random-20")], contenders(["nearest-path", "lookahead-oracle"]), episodes=2
@@ -82,9 +82,9 @@ def test_oracle_is_never_the_best_heuristic_and_refuses_teams() -> None:
 def test_imitation_labels_real_decisions_and_fits_them() -> None:
     from frontier_marl.config import make_config
     from frontier_marl.envs.parallel import FrontierParallelEnv
-    from frontier_marl.evaluation.families import family, variant_configs
+    from frontier_marl.evaluation.benchmark.families import family, variant_configs
+    from frontier_marl.policies.networks.slot_dqn import SlotScorer
     from frontier_marl.training.imitation import Dataset, fit, play
-    from frontier_marl.training.slot_policy import SlotScorer
 
     own = {"features": "explorer", "n_slots": 6, "gain": "unknown", "commit": "until-reached"}
     world = variant_configs(family("random-20"))[0]
@@ -118,8 +118,8 @@ def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
 
     from frontier_marl import FrontierParallelEnv
     from frontier_marl.core.slots import SlotArrays
+    from frontier_marl.policies.models import load_model
     from frontier_marl.training.cem import feature_names
-    from frontier_marl.training.evaluate_model import load_model
 
     script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
     probe = runpy.run_path(str(script))

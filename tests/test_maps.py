@@ -13,15 +13,15 @@ from scipy import ndimage
 
 import frontier_marl
 from frontier_marl.config import make_config
-from frontier_marl.core.map_files import format_text_map, load_map, parse_pgm, parse_text_map
-from frontier_marl.core.maps import FOUR_CONNECTED, floorplan_map, rooms_map
-from frontier_marl.example_maps import (
+from frontier_marl.core.example_maps import (
     EXAMPLE_MAPS,
     example_map_names,
     example_map_path,
     generate_example_map,
     resolve_map,
 )
+from frontier_marl.core.map_files import format_text_map, load_map, parse_pgm, parse_text_map
+from frontier_marl.core.maps import FOUR_CONNECTED, floorplan_map, rooms_map
 
 REPO = Path(__file__).resolve().parents[1]
 # CI keeps a copy of shared/ beside the clone; locally it is ../shared as well.

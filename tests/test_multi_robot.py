@@ -18,19 +18,19 @@ from hypothesis import strategies as st
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 import frontier_marl
-from frontier_marl.cli import main
+from frontier_marl.cli.main import main
 from frontier_marl.config import make_config
+from frontier_marl.core.example_maps import example_map_path
 from frontier_marl.core.grid import FREE, OCCUPIED
-from frontier_marl.evaluation import (
+from frontier_marl.evaluation import evaluate
+from frontier_marl.evaluation.metrics import makespan_curve, overlap_ratio
+from frontier_marl.policies import (
     TEAM_POLICIES,
     CoordinatedAssignment,
     UtilityDiscount,
-    evaluate,
     make_policy,
 )
-from frontier_marl.evaluation.metrics import makespan_curve, overlap_ratio
-from frontier_marl.example_maps import example_map_path
-from frontier_marl.rewards import StepEvents, step_outcome
+from frontier_marl.sim.rewards import StepEvents, step_outcome
 from tests.helpers import info_with, live_slot
 from tests.oracles import bfs as bfs_distances
 

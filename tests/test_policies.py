@@ -8,7 +8,7 @@ import pytest
 
 import frontier_marl
 from frontier_marl.core.grid import FREE
-from frontier_marl.evaluation import (
+from frontier_marl.policies import (
     POLICIES,
     CallablePolicy,
     CostUtility,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-from frontier_marl.progress import progress_bar
+from frontier_marl.utils.progress import progress_bar
 
 
 class Terminal(io.StringIO):

@@ -1,4 +1,4 @@
-"""Tests for frontier_marl.render."""
+"""Tests for frontier_marl.render.frames."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
-from frontier_marl.render import (
+from frontier_marl.render.frames import (
     CLUSTER_PALETTE,
     COLOR_FREE,
     COLOR_GAP,
@@ -20,7 +20,7 @@ from frontier_marl.render import (
     render_ansi,
     render_rgb,
 )
-from frontier_marl.viewer import HumanViewer, write_gif
+from frontier_marl.render.viewer import HumanViewer, write_gif
 
 PX = 12
 H, W = 3, 5

@@ -17,8 +17,8 @@ import pytest
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("supersuit")
 
-from frontier_marl.cli import main  # noqa: E402
-from frontier_marl.workflows.reproduce import HEURISTICS, reproduce  # noqa: E402
+from frontier_marl.cli.main import main  # noqa: E402
+from frontier_marl.experiments.reproduce import HEURISTICS, reproduce  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 STEPS, EPISODES = 2000, 3
@@ -294,7 +294,7 @@ DEGENERATE = {"action_shares": [0.95, 0.05, 0.0, 0.0]}
 
 
 def test_genuine_checks_ask_every_seed_to_be_genuine_and_the_mean_to_reach_the_bar() -> None:
-    from frontier_marl.workflows.comparison import genuine_checks
+    from frontier_marl.experiments.comparison import genuine_checks
 
     assert genuine_checks([GENUINE, GENUINE], 13.1) == {
         "max_share_at_most_70pct": True,
@@ -308,7 +308,7 @@ def test_genuine_checks_ask_every_seed_to_be_genuine_and_the_mean_to_reach_the_b
 
 
 def test_pool_evaluations_holds_every_run_s_episodes() -> None:
-    from frontier_marl.workflows.comparison import pool_evaluations
+    from frontier_marl.experiments.comparison import pool_evaluations
 
     a = {
         "episodes": 2,

@@ -1,4 +1,4 @@
-"""Tests for frontier_marl.rewards: the thesis's reward tables and the oscillation test."""
+"""Tests for frontier_marl.sim.rewards: the thesis's reward tables and the oscillation test."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from frontier_marl.config import RewardConfig
-from frontier_marl.rewards import OscillationDetector, StepEvents, step_outcome
+from frontier_marl.sim.rewards import OscillationDetector, StepEvents, step_outcome
 
 R1 = RewardConfig(kind="reward1")
 R2 = RewardConfig(kind="reward2")

@@ -12,17 +12,16 @@ import torch
 from sb3_contrib import MaskablePPO
 from stable_baselines3 import PPO
 
-from frontier_marl.cli import main
+from frontier_marl.cli.main import main
 from frontier_marl.config import make_config
-from frontier_marl.evaluation.policies import ModelPolicy
-from frontier_marl.training.algorithms import loader
-from frontier_marl.training.batched_vec_env import make_batched_vec_env
-from frontier_marl.training.evaluate_model import load_model
-from frontier_marl.training.experiment import experiment_from_dict, parse_override
-from frontier_marl.training.slot_actor_critic import (
+from frontier_marl.policies.base import ModelPolicy
+from frontier_marl.policies.models import load_model, loader
+from frontier_marl.policies.networks.slot_actor_critic import (
     MaskableSlotActorCriticPolicy,
     SlotActorCriticPolicy,
 )
+from frontier_marl.training.batched_vec_env import make_batched_vec_env
+from frontier_marl.training.experiment import experiment_from_dict, parse_override
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown", "reward": "travel"}
 CLASSES = [(PPO, SlotActorCriticPolicy), (MaskablePPO, MaskableSlotActorCriticPolicy)]

@@ -6,7 +6,7 @@ import json
 import runpy
 from pathlib import Path
 
-from frontier_marl.cli import main as cli
+from frontier_marl.cli.main import main as cli
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from frontier_marl.example_maps import example_map_path
+from frontier_marl.core.example_maps import example_map_path
 from frontier_marl.training.experiment import experiment_from_dict, load_experiment
 
 
@@ -55,7 +55,7 @@ def test_multi_robot_comparison_of_a_policy_that_never_reaches_a_level() -> None
     import runpy
     from pathlib import Path
 
-    from frontier_marl.evaluation import make_policy
+    from frontier_marl.policies import make_policy
 
     module = runpy.run_path(str(Path(__file__).resolve().parents[1] / "baselines/multi_robot.py"))
     settings_ = {

@@ -331,7 +331,7 @@ def test_training_is_reproducible_for_a_seed(tmp_path: Path) -> None:
 def test_resume_continues_step_count_and_replay_buffer(tmp_path: Path) -> None:
     from stable_baselines3.common.callbacks import BaseCallback
 
-    from frontier_marl.training.checkpoints import find_checkpoint
+    from frontier_marl.policies.model_files import find_checkpoint
     from frontier_marl.training.train import resume_experiment, train
 
     class InterruptAt(BaseCallback):
@@ -386,7 +386,7 @@ def _metrics(run_dir: Path) -> list[dict]:
 
 
 def test_resume_refuses_env_or_seed_changes(finished_run: tuple) -> None:
-    from frontier_marl.training.checkpoints import find_checkpoint
+    from frontier_marl.policies.model_files import find_checkpoint
     from frontier_marl.training.train import resume_experiment
 
     run_dir, _ = finished_run
@@ -401,8 +401,9 @@ def test_resume_refuses_env_or_seed_changes(finished_run: tuple) -> None:
 
 def test_mismatched_layout_gives_a_named_error(finished_run: tuple) -> None:
     from frontier_marl.config import make_config
-    from frontier_marl.training.evaluate_model import evaluate_model, load_model
-    from frontier_marl.training.metadata import ModelEnvMismatchError
+    from frontier_marl.evaluation.model_evaluation import evaluate_model
+    from frontier_marl.policies.metadata import ModelEnvMismatchError
+    from frontier_marl.policies.models import load_model
 
     run_dir, _ = finished_run
     loaded = load_model(run_dir)
@@ -420,7 +421,7 @@ def test_mismatched_layout_gives_a_named_error(finished_run: tuple) -> None:
 
 
 def test_degeneracy_flag() -> None:
-    from frontier_marl.training.evaluate_model import degeneracy
+    from frontier_marl.evaluation.model_evaluation import degeneracy
 
     assert degeneracy([0.95, 0.05, 0.0, 0.0])["degenerate"] is True
     assert degeneracy([0.95, 0.05, 0.0, 0.0])["dominant_action"] == 0

@@ -107,7 +107,7 @@ def test_evaluation_map_mode_can_differ_from_training(tmp_path: Path) -> None:
 
 
 def test_cli_evaluates_the_best_policy_folder(validated_run: tuple, capsys) -> None:
-    from frontier_marl.cli import main
+    from frontier_marl.cli.main import main
 
     run_dir, _ = validated_run
     assert main(["evaluate", str(run_dir / "best"), "--episodes", "1", "--no-progress"]) == 0
@@ -117,7 +117,7 @@ def test_cli_evaluates_the_best_policy_folder(validated_run: tuple, capsys) -> N
 def test_resume_forgets_validations_past_the_checkpoint(tmp_path: Path) -> None:
     from stable_baselines3.common.callbacks import BaseCallback
 
-    from frontier_marl.training.checkpoints import list_checkpoints
+    from frontier_marl.policies.model_files import list_checkpoints
     from frontier_marl.training.train import resume_experiment, train
 
     class InterruptAt(BaseCallback):

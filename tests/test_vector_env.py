@@ -19,7 +19,7 @@ from frontier_marl.core.frontiers import cluster_frontiers
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.worlds import WorldParams, Worlds
-from frontier_marl.registration import GYM_ID
+from frontier_marl.envs.registration import GYM_ID
 
 STEP_KEYS = ("explored_fraction", "coverage", "new_cells", "travelled", "step", "end_reason")
 FULL_KEYS = ("padding", "oscillation")

@@ -53,8 +53,8 @@ def run(bin_dir: Path, *args: str, cwd: Path) -> str:
 def test_the_installed_package_is_the_wheel(installed: Path, tmp_path: Path) -> None:
     code = (
         "import json, frontier_marl\n"
-        "from frontier_marl.example_maps import example_map_path\n"
-        "from frontier_marl.pretrained import pretrained_model_dir\n"
+        "from frontier_marl.core.example_maps import example_map_path\n"
+        "from frontier_marl.policies.models import pretrained_model_dir\n"
         "from frontier_marl.training.experiment import shipped_configs\n"
         "print(json.dumps([frontier_marl.__file__, str(example_map_path('rooms-32')),"
         " str(pretrained_model_dir('thesis-config01')), shipped_configs()]))"

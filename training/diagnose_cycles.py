@@ -18,8 +18,7 @@ from collections import Counter
 from pathlib import Path
 
 from frontier_marl.envs.gym_env import FrontierExploreEnv
-from frontier_marl.pretrained import PRETRAINED, pretrained_model_dir
-from frontier_marl.training.evaluate_model import load_model
+from frontier_marl.policies.models import PRETRAINED, load_model, pretrained_model_dir
 
 
 def diagnose(model_dir: Path, episodes: int) -> dict[str, float]:

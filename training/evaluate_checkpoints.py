@@ -23,8 +23,9 @@ def evaluate_checkpoints(
     run_dir: str | Path, seeds: list[int], episodes: int = 30
 ) -> list[dict[str, Any]]:
     """One row per checkpoint: its step and, per seed, mean reward and terminations."""
-    from frontier_marl.training.checkpoints import list_checkpoints
-    from frontier_marl.training.evaluate_model import evaluate_model, load_model
+    from frontier_marl.evaluation.model_evaluation import evaluate_model
+    from frontier_marl.policies.model_files import list_checkpoints
+    from frontier_marl.policies.models import load_model
 
     checkpoints = list_checkpoints(run_dir)
     if not checkpoints:

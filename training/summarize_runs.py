@@ -22,9 +22,9 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.json_files import write_json
+from frontier_marl.experiments.baselines import without_curves
 from frontier_marl.training.callbacks import read_metrics
-from frontier_marl.workflows.baselines import without_curves
+from frontier_marl.utils.json_files import write_json
 
 
 def strip_curves(row: dict[str, Any]) -> dict[str, Any]:

@@ -1,4 +1,4 @@
-"""Thin adapters over :class:`frontier_marl.engine.ExplorationMDP`."""
+"""Thin adapters over :class:`frontier_marl.sim.engine.ExplorationMDP`."""
 
 from frontier_marl.envs.gym_env import FrontierExploreEnv
 from frontier_marl.envs.parallel import FrontierParallelEnv

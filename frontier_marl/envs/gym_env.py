@@ -10,9 +10,9 @@ from gymnasium import spaces
 
 from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.core.world import World
-from frontier_marl.engine import ExplorationMDP
 from frontier_marl.envs.infos import build_infos, check_info_level
-from frontier_marl.envs.rendering import RENDER_MODES, Renderer
+from frontier_marl.render.renderer import RENDER_MODES, Renderer
+from frontier_marl.sim.engine import ExplorationMDP
 
 
 class FrontierExploreEnv(gym.Env):

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from frontier_marl.engine import ExplorationMDP, StepResult
+from frontier_marl.sim.engine import ExplorationMDP, StepResult
 
 INFO_LEVELS = ("full", "minimal")
 

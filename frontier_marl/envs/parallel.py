@@ -1,4 +1,4 @@
-"""PettingZoo ParallelEnv adapter over :class:`~frontier_marl.engine.ExplorationMDP`."""
+"""PettingZoo ParallelEnv adapter over :class:`~frontier_marl.sim.engine.ExplorationMDP`."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from pettingzoo import ParallelEnv
 
 from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.core.world import World
-from frontier_marl.engine import ExplorationMDP
 from frontier_marl.envs.infos import build_infos, check_info_level
-from frontier_marl.envs.rendering import RENDER_MODES, Renderer
+from frontier_marl.render.renderer import RENDER_MODES, Renderer
+from frontier_marl.sim.engine import ExplorationMDP
 
 
 class FrontierParallelEnv(ParallelEnv):
@@ -32,9 +32,9 @@ class FrontierParallelEnv(ParallelEnv):
 
     **Observation space.** A flat ``Box`` of ``n_slots x F`` slot features, or a ``Dict`` with
     ``clusters``, ``agent_position`` and ``action_mask`` keys; see
-    :mod:`frontier_marl.observations`.
+    :mod:`frontier_marl.sim.observations`.
 
-    **Rewards.** Reward 1 or Reward 2 of the thesis (:mod:`frontier_marl.rewards`).
+    **Rewards.** Reward 1 or Reward 2 of the thesis (:mod:`frontier_marl.sim.rewards`).
 
     **Starting state.** The static layout (``map_seed``) or a fresh random layout (dynamic);
     robots start on distinct random cells of the largest free component and sense there.

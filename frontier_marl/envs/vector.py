@@ -1,4 +1,4 @@
-"""Gymnasium ``VectorEnv`` over :class:`~frontier_marl.batch_engine.BatchMDP`: N worlds in one
+"""Gymnasium ``VectorEnv`` over :class:`~frontier_marl.sim.batch_engine.BatchMDP`: N worlds in one
 call.
 
 Sub-environment ``j`` of the vector is robot ``j % K`` of world ``j // K`` (K robots per world
@@ -17,9 +17,9 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from frontier_marl.batch_engine import BatchMDP
 from frontier_marl.config import EnvConfig, make_config
-from frontier_marl.rewards import REASONS
+from frontier_marl.sim.batch_engine import BatchMDP
+from frontier_marl.sim.rewards import REASONS
 
 VECTOR_INFO_LEVELS = ("full", "minimal", "mask")
 _REASON_NAMES = np.array(REASONS, dtype=object)

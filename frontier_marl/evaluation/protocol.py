@@ -51,13 +51,13 @@ from frontier_marl.evaluation.metrics import (
     makespan_curve,
     overlap_ratio,
 )
-from frontier_marl.evaluation.policies import Policy
 from frontier_marl.evaluation.records import (
     DEFAULT_LEVELS,
     EpisodeRecord,
     EvaluationResult,
     level_key,
 )
+from frontier_marl.policies.base import Policy
 
 # --------------------------------------------------------------------------- env adapters
 

@@ -51,10 +51,10 @@ def learner(algorithm: str, policy: str) -> tuple[Any, Any]:
     if policy != "slot-scorer":
         return algorithm_class(algorithm), None
     if algorithm == "dqn":
-        from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
+        from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
 
         return MaskedDQN, SlotDQNPolicy
-    from frontier_marl.training import slot_actor_critic
+    from frontier_marl.policies.networks import slot_actor_critic
 
     if algorithm == "ppo":
         return algorithm_class(algorithm), slot_actor_critic.SlotActorCriticPolicy
@@ -65,16 +65,3 @@ def keyword_names(algorithm: str) -> set[str]:
     """The keyword arguments of ``algorithm``'s SB3 class that a config may set."""
     signature = inspect.signature(algorithm_class(algorithm).__init__)
     return set(signature.parameters) - {"self"} - RESERVED
-
-
-def loader(label: str | None) -> Any:
-    """The SB3 class that loads a model whose metadata records ``label`` as its algorithm
-    (``None``, a model without metadata: DQN, as every model was before PPO)."""
-    by_label = {name: algorithm for algorithm, name in LABEL.items()}
-    if label is None:
-        return algorithm_class("dqn")
-    if label not in by_label:
-        raise ValueError(
-            f"the model's metadata names algorithm {label!r}; known: {sorted(by_label)}"
-        )
-    return algorithm_class(by_label[label])

@@ -19,7 +19,7 @@ import numpy as np
 from stable_baselines3.common.vec_env import VecEnv, VecMonitor
 
 from frontier_marl.envs.vector import FrontierVectorEnv
-from frontier_marl.rewards import REASONS
+from frontier_marl.sim.rewards import REASONS
 from frontier_marl.training.vec_env import END_REASON_KEY, TRUNCATED_KEY, copy_seeds
 
 

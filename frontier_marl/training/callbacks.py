@@ -41,7 +41,7 @@ class Periodic(BaseCallback):
 
 
 class ProgressBar(BaseCallback):
-    """A progress bar (:mod:`frontier_marl.progress`) over the session's steps, with the
+    """A progress bar (:mod:`frontier_marl.utils.progress`) over the session's steps, with the
     rolling episode reward and epsilon. Unlike SB3's ``ProgressBarCallback`` (a rich bar
     redrawn from every step, which cost about a quarter of the training time here) it touches
     the bar every ``every`` steps.
@@ -55,7 +55,7 @@ class ProgressBar(BaseCallback):
         self._next = 0
 
     def _on_training_start(self) -> None:
-        from frontier_marl.progress import progress_bar
+        from frontier_marl.utils.progress import progress_bar
 
         total = int(self.locals["total_timesteps"])
         self._shown = self.model.num_timesteps

@@ -1,7 +1,7 @@
 """The cross-entropy method on a linear slot scorer (``train.algorithm = "cem"``).
 
 The policy scores every valid slot by the dot product of its features with one weight vector
-(:class:`~frontier_marl.training.slot_policy.LinearSlotScorer`) and takes the best slot. CEM
+(:class:`~frontier_marl.policies.networks.slot_dqn.LinearSlotScorer`) and takes the best slot. CEM
 searches the weights directly on the benchmark's metric, T99, with no value function to
 learn: each generation draws ``population`` weight vectors around the current mean (the mean
 itself first), plays each on the same fresh episodes of every training family (``episodes``
@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.slot_features import slot_feature_names
+from frontier_marl.sim.features import slot_feature_names
 from frontier_marl.training.family_validation import FAILURE
 
 if TYPE_CHECKING:
@@ -176,7 +176,7 @@ def changes_text(changes: Mapping[str, Mapping[str, float]]) -> str:
 
 def shipped_weights(name: str = "explorer") -> dict[str, float]:
     """The weights by feature name of the shipped linear scorer ``name``."""
-    from frontier_marl.pretrained import pretrained_model_dir
+    from frontier_marl.policies.models import pretrained_model_dir
 
     return json.loads((pretrained_model_dir(name) / "model.json").read_text())["weights"]
 
@@ -199,8 +199,8 @@ def candidate_score(
 
 def linear_model(cfg: EnvConfig, weights: np.ndarray, device: str = "cpu") -> Any:
     """A ``MaskedDQN`` whose linear slot scorer holds ``weights`` (for saving and validation)."""
+    from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
     from frontier_marl.training.batched_vec_env import make_batched_vec_env
-    from frontier_marl.training.slot_policy import MaskedDQN, SlotDQNPolicy
 
     env = make_batched_vec_env({"config": cfg}, 1)
     model = MaskedDQN(
@@ -221,7 +221,7 @@ def linear_metadata(
 ) -> dict[str, Any]:
     """The ``model.json`` of a linear slot scorer: the usual metadata, its weights by feature
     name, and ``extra`` (e.g. ``trained_by``)."""
-    from frontier_marl.training.metadata import build_metadata
+    from frontier_marl.policies.metadata import build_metadata
 
     current = model.policy.q_net.q_net.weight.detach().cpu().numpy()
     weights = {name: float(w) for name, w in zip(feature_names(cfg), current, strict=True)}
@@ -239,7 +239,7 @@ def linear_metadata(
 def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experiment) -> None:
     """Save a linear slot scorer with hand-set ``weights`` (by feature name, the others 0) on
     ``experiment``'s observation as a model folder (``model.zip`` and ``model.json``)."""
-    from frontier_marl.training.metadata import save_metadata
+    from frontier_marl.policies.metadata import save_metadata
 
     cfg = experiment.env_config()
     model = linear_model(cfg, weight_vector(weights, feature_names(cfg), "hand-set weights"))
@@ -262,13 +262,13 @@ def set_weights(model: Any, weights: np.ndarray) -> None:
 def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) -> TrainResult:
     """Run CEM for ``experiment`` into ``run_dir`` (summary in ``RUN/cem.json``, one record
     per generation in ``RUN/cem.jsonl``)."""
-    from frontier_marl.evaluation.families import family
-    from frontier_marl.progress import progress_bar as make_bar
+    from frontier_marl.evaluation.benchmark.families import family
+    from frontier_marl.policies.metadata import save_metadata
     from frontier_marl.training.family_validation import FamilyValidator
-    from frontier_marl.training.metadata import save_metadata
     from frontier_marl.training.plots import plot_family_validation
     from frontier_marl.training.train import TrainResult
     from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
+    from frontier_marl.utils.progress import progress_bar as make_bar
 
     settings, cem = experiment.train, CEMSettings(**experiment.cem)
     configs = experiment.env_configs()

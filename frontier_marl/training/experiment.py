@@ -39,8 +39,8 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_keys, make_config
-from frontier_marl.example_maps import EXAMPLE_MAPS, example_map_path
-from frontier_marl.thesis import DQN_HYPERPARAMETERS
+from frontier_marl.config.thesis import DQN_HYPERPARAMETERS
+from frontier_marl.core.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.training.algorithms import SECTION, keyword_names
 from frontier_marl.training.cem import CEM_KEYS, CEMSettings, feature_names, weight_vector
 from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
@@ -89,7 +89,7 @@ class Experiment:
         """One env config per training family and team size (``[env]`` on each family's world
         with ``train.agents`` robots, families first), or the ``[env]`` config alone."""
         if self.train.families:
-            from frontier_marl.evaluation.families import family, variant_configs
+            from frontier_marl.evaluation.benchmark.families import family, variant_configs
 
             return [
                 variant_configs(family(name), self.env, agents)[0]

@@ -20,13 +20,13 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
-from frontier_marl.evaluation.benchmark import Contender, default_commit, heuristic, run_family
-from frontier_marl.evaluation.families import (
+from frontier_marl.evaluation.benchmark.families import (
     OBSERVATION_KEYS,
     family,
     variant_configs,
     world_settings,
 )
+from frontier_marl.evaluation.benchmark.run import Contender, default_commit, heuristic, run_family
 from frontier_marl.evaluation.records import level_key
 
 FAILURE = 1.0  # the relative T99 difference an episode that never reached 99 % counts as
@@ -64,7 +64,7 @@ class FamilyValidator:
         ]
 
     def _contender(self, model: Any) -> Contender:
-        from frontier_marl.evaluation.policies import ModelPolicy
+        from frontier_marl.policies.base import ModelPolicy
 
         def config(world: EnvConfig) -> EnvConfig:
             return make_config(None, **{**world_settings(world), **self._own})

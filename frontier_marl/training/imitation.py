@@ -7,7 +7,7 @@ them to one growing dataset. Round 0 follows the teacher; round ``i`` follows it
 probability ``beta ** i`` per decision and the student otherwise, so later rounds label the
 states the student itself reaches (DAgger). After each round the student's Q-network is fitted
 on the whole dataset: its Q-value of a slot regresses on minus the slot's extra cost over the
-cheapest one, in :data:`~frontier_marl.slot_features.CELLS` units, so its greedy choice
+cheapest one, in :data:`~frontier_marl.sim.features.CELLS` units, so its greedy choice
 approximates the teacher's from the robot's own observation.
 """
 
@@ -21,9 +21,9 @@ import numpy as np
 import torch as th
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.evaluation.families import COVERAGE
-from frontier_marl.evaluation.lookahead import lookahead_costs
-from frontier_marl.slot_features import CELLS
+from frontier_marl.evaluation.benchmark.families import COVERAGE
+from frontier_marl.policies.lookahead import lookahead_costs
+from frontier_marl.sim.features import CELLS
 
 Actor = Callable[[dict[str, np.ndarray]], int]
 

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.training.evaluate_model import DEGENERACY_THRESHOLD
+from frontier_marl.evaluation.model_evaluation import DEGENERACY_THRESHOLD
 
 
 def _pyplot() -> Any:

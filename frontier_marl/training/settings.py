@@ -46,10 +46,10 @@ class TrainSettings:
         policy: ``auto`` (SB3's ``MlpPolicy`` or ``MultiInputPolicy``, by observation) or
             ``slot-scorer`` (the masked, permutation-equivariant slot scorer; needs
             ``features = "explorer"``): with DQN the Q-network of
-            :mod:`frontier_marl.training.slot_policy`, trained by ``MaskedDQN``; with PPO the
-            actor-critic of :mod:`frontier_marl.training.slot_actor_critic`.
-        families: benchmark map families to train on (:mod:`frontier_marl.evaluation.families`),
-            ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
+            :mod:`frontier_marl.policies.networks.slot_dqn`, trained by ``MaskedDQN``; with PPO the
+            actor-critic of :mod:`frontier_marl.policies.networks.slot_actor_critic`.
+        families: benchmark map families to train on
+            (:mod:`frontier_marl.evaluation.benchmark.families`), ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
             range; ``[env]`` then sets the observation and reward (not the map). Empty: the
             ``[env]`` world.
         agents: team sizes to train on with ``families``: ``n_envs`` worlds of every family
@@ -118,7 +118,7 @@ class TrainSettings:
         if self.policy not in POLICIES:
             raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
         if self.families:
-            from frontier_marl.evaluation.families import check_families
+            from frontier_marl.evaluation.benchmark.families import check_families
 
             check_families(self.families, "train.families")
             if self.vec_env != "batched":

@@ -33,19 +33,19 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.config import make_config
-from frontier_marl.json_files import write_json
-from frontier_marl.training.algorithms import LABEL, SECTION, learner
-from frontier_marl.training.checkpoints import (
+from frontier_marl.policies.metadata import build_metadata, save_metadata
+from frontier_marl.policies.model_files import (
     MODEL_FILE,
     Checkpoint,
     find_checkpoint,
     list_checkpoints,
-    save_checkpoint,
 )
+from frontier_marl.training.algorithms import LABEL, SECTION, learner
+from frontier_marl.training.checkpoints import save_checkpoint
 from frontier_marl.training.experiment import Experiment, TrainSettings, experiment_from_dict
-from frontier_marl.training.metadata import build_metadata, save_metadata
 from frontier_marl.training.run_files import plot_learning_curve, record_session, set_logger
 from frontier_marl.training.validation import BEST_DIR
+from frontier_marl.utils.json_files import write_json
 
 #: Train settings a resumed run may change; everything else must match the checkpoint.
 RESUMABLE_TRAIN_KEYS = {
@@ -134,7 +134,7 @@ def training_vec_env(experiment: Experiment, seed: int) -> Any:
         return make(kwargs, settings.n_envs, seed, bootstrap)
     from stable_baselines3.common.vec_env import VecMonitor
 
-    from frontier_marl.evaluation.families import family
+    from frontier_marl.evaluation.benchmark.families import family
 
     parts = []
     names = [name for name in settings.families for _ in settings.agents]
@@ -317,7 +317,7 @@ def train(
         )
         best = run_dir / BEST_DIR / MODEL_FILE
         if settings.validate_every > 0 and best.is_file():
-            from frontier_marl.training.evaluate_model import load_model
+            from frontier_marl.policies.models import load_model
 
             loaded = load_model(best, device=settings.device)
             result.best_evaluation = _final_evaluation(
@@ -366,7 +366,8 @@ def _final_evaluation(
     label: str = "",
 ) -> dict[str, Any]:
     """The protocol evaluation of a model, saved in ``run_dir`` (the run's or ``RUN/best/``)."""
-    from frontier_marl.training.evaluate_model import LoadedModel, evaluate_model
+    from frontier_marl.evaluation.model_evaluation import evaluate_model
+    from frontier_marl.policies.models import LoadedModel
     from frontier_marl.training.plots import plot_action_histogram
 
     loaded = LoadedModel(model=model, path=model_path, metadata=meta)

@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.training.checkpoints import MODEL_FILE
+from frontier_marl.policies.metadata import load_metadata, save_metadata
+from frontier_marl.policies.model_files import MODEL_FILE
 from frontier_marl.training.experiment import TrainSettings
-from frontier_marl.training.metadata import load_metadata, save_metadata
 
 BEST_DIR = "best"
 LOG_FILE = "validation.jsonl"
@@ -72,7 +72,8 @@ class BestPolicyKeeper:
             shutil.rmtree(self.best_dir)
 
     def _mean_reward(self, model: Any) -> dict[str, Any]:
-        from frontier_marl.evaluation import ModelPolicy, evaluate
+        from frontier_marl.evaluation import evaluate
+        from frontier_marl.policies import ModelPolicy
 
         result = evaluate(
             {"config": self.cfg},

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.training.checkpoints import Checkpoint
+from frontier_marl.policies.model_files import Checkpoint
 from frontier_marl.training.experiment import Experiment
 
 #: How often (environment steps) a worker reports its progress and looks for a stop request.
@@ -161,7 +161,7 @@ class _Bars:
         self._bars: list[Any] = []
         if not progress:
             return
-        from frontier_marl.progress import progress_bar
+        from frontier_marl.utils.progress import progress_bar
 
         for i, job in enumerate(jobs):
             start = 0 if job.checkpoint is None else job.checkpoint.step

@@ -162,7 +162,7 @@ def slot_rows(info: Mapping[str, Any]) -> list[tuple[Any, ...]]:
 def play(kwargs: Mapping[str, Any], policy_name: str, seed: int) -> dict[str, Any]:
     """One episode's digests (one per stream) and a few plain figures for readable diffs."""
     import frontier_marl
-    from frontier_marl.evaluation import make_policy
+    from frontier_marl.policies import make_policy
 
     env = frontier_marl.parallel_env(**kwargs)
     policy = make_policy(policy_name, seed)

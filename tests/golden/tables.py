@@ -88,7 +88,7 @@ def _strip_config(value: Any) -> Any:
 
 def run(name: str) -> dict[str, Any]:
     """The command's table (printed lines, file paths as ``<path>``) and its JSON digest."""
-    from frontier_marl.cli import main
+    from frontier_marl.cli.main import main
 
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder) / "rows.json"

@@ -1,0 +1,163 @@
+"""``frontier-marl evaluate``: the thesis protocol on a saved model, beside greedy-distance.
+
+Examples::
+
+    frontier-marl evaluate runs/config01/seed0                 # the run's final model.zip
+    frontier-marl evaluate runs/config01/seed0/model.zip --map-mode dynamic --episodes 30 \\
+        --json eval.json --plot actions.png
+
+The env is the one the model was trained on (read from the ``model.json`` beside it), changed
+only by ``--map-mode``, ``--preset`` and ``--set``. Reported: mean and std of the total episode
+reward, terminations (episodes reaching the exploration threshold), action shares and the
+degeneracy flag (one action in more than 90 % of steps), for the model (deterministic) and
+greedy-distance on the same episodes. A model whose observation layout or spaces do not match
+the env is refused with the list of differences.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from frontier_marl.config import PRESETS
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from frontier_marl.cli.arguments import add_set_argument, non_negative_int, positive_int
+
+    parser.add_argument(
+        "model",
+        metavar="MODEL",
+        help="model.zip, a run folder, a checkpoint folder, or a shipped "
+        "model's name (thesis-config01)",
+    )
+    parser.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=30,
+        help="evaluation episodes (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--map-mode",
+        choices=["static", "dynamic"],
+        default=None,
+        help="map mode (default: the one the model was trained on)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative_int,
+        default=0,
+        help="episode i uses reset seed SEED + i (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=sorted(PRESETS),
+        default=None,
+        help="evaluate on another geometry (default: the training env's)",
+    )
+    parser.add_argument(
+        "--agents",
+        type=positive_int,
+        default=None,
+        help="robots sharing the belief; each acts with the shared-parameter "
+        "model (default: as trained)",
+    )
+    add_set_argument(parser, "any other env parameter (repeatable)")
+    parser.add_argument(
+        "--heuristics",
+        default="greedy-distance",
+        help="comma-separated heuristics run on the same episodes "
+        "(default: %(default)s; empty for none)",
+    )
+    parser.add_argument(
+        "--json",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the result (rows with per-episode records) as JSON",
+    )
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the action histogram as a PNG",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def _fail(message: str) -> int:
+    print(f"frontier-marl evaluate: error: {message}", file=sys.stderr)
+    return 2
+
+
+def run(args: argparse.Namespace) -> int:
+    from frontier_marl.cli.arguments import parse_policies, parse_set_options
+    from frontier_marl.evaluation.model_evaluation import (
+        evaluate_model,
+        evaluation_env_config,
+        format_comparison,
+    )
+    from frontier_marl.policies.metadata import ModelEnvMismatchError
+    from frontier_marl.policies.models import load_model
+
+    try:
+        overrides = parse_set_options(args.overrides)
+        if args.map_mode is not None:
+            overrides["map_mode"] = args.map_mode
+        if args.agents is not None:
+            overrides["n_agents"] = args.agents
+        heuristics = parse_policies(args.heuristics) if args.heuristics.strip() else []
+        loaded = load_model(args.model)
+        cfg = evaluation_env_config(loaded, args.preset, overrides)
+    except ValueError as exc:
+        return _fail(str(exc))
+    if loaded.metadata is None:
+        print(
+            f"note: {loaded.path} has no model.json metadata; evaluating on "
+            f"{args.preset or 'thesis-20x20'} with the given overrides",
+            file=sys.stderr,
+        )
+
+    from frontier_marl.utils.progress import progress_bar
+
+    total = args.episodes * (1 + len(heuristics))
+    with progress_bar(total, disable=args.no_progress, unit="ep") as bar:
+
+        def tick(label: str, _i: int) -> None:
+            bar.set_description(label)
+            bar.update(1)
+
+        try:
+            result = evaluate_model(
+                loaded,
+                cfg,
+                episodes=args.episodes,
+                seed=args.seed,
+                heuristics=heuristics,
+                name="model",
+                on_episode=tick,
+            )
+        except ModelEnvMismatchError as exc:
+            bar.close()
+            return _fail(str(exc))
+    layout = f"map_seed={cfg.map_seed}" if cfg.map_mode == "static" else "fresh layout per seed"
+    print(
+        f"{loaded.path} ({result['num_timesteps']} training steps): {cfg.height}x{cfg.width}, "
+        f"r={cfg.perception_range}, {cfg.map_mode} map ({layout}), {args.episodes} episodes, "
+        f"seeds {args.seed}..{args.seed + args.episodes - 1}, deterministic"
+    )
+    print(format_comparison(result))
+    if args.json is not None:
+        from frontier_marl.utils.json_files import write_json
+
+        write_json(result, args.json)
+        print(f"wrote {args.json}")
+    if args.plot is not None:
+        from frontier_marl.training.plots import plot_action_histogram
+
+        args.plot.parent.mkdir(parents=True, exist_ok=True)
+        plot_action_histogram(result["rows"], args.plot, title=f"{loaded.path.name}: actions")
+        print(f"wrote {args.plot}")
+    return 0

@@ -1,1 +1,0 @@
-"""Subcommands of the ``frontier-marl`` CLI (see :mod:`frontier_marl.cli`)."""

@@ -1,0 +1,136 @@
+"""Evaluation of a trained model with the thesis protocol, beside a heuristic.
+
+The episodes are run by :func:`frontier_marl.evaluation.evaluate` (one protocol for models and
+heuristics); the SB3 model acts through :class:`frontier_marl.evaluation.ModelPolicy` with
+``deterministic=True`` (epsilon = 0). Before any episode the model is checked against the env
+(:func:`~frontier_marl.policies.metadata.check_compatible`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from frontier_marl.config import EnvConfig, config_to_dict, make_config
+from frontier_marl.policies.metadata import env_config_from_metadata
+from frontier_marl.policies.models import LoadedModel, check_model_env
+
+#: An action taken in more than this share of all decisions flags a degenerate policy.
+DEGENERACY_THRESHOLD = 0.9
+
+
+def degeneracy(shares: Sequence[float], threshold: float = DEGENERACY_THRESHOLD) -> dict[str, Any]:
+    """Whether one action takes more than ``threshold`` of all decisions."""
+    if not shares:
+        return {
+            "degenerate": False,
+            "dominant_action": None,
+            "dominant_share": 0.0,
+            "threshold": threshold,
+        }
+    top = max(range(len(shares)), key=lambda i: shares[i])
+    return {
+        "degenerate": bool(shares[top] > threshold),
+        "dominant_action": int(top),
+        "dominant_share": float(shares[top]),
+        "threshold": threshold,
+    }
+
+
+def evaluate_model(
+    loaded: LoadedModel,
+    cfg: EnvConfig,
+    episodes: int = 30,
+    seed: int = 0,
+    heuristics: Sequence[str] = ("greedy-distance",),
+    name: str = "model",
+    on_episode: Callable[[str, int], None] | None = None,
+) -> dict[str, Any]:
+    """The model and each heuristic on the same episodes (seeds ``seed .. seed+episodes-1``).
+
+    Returns a JSON-able dict: ``model`` (the model's row with ``degeneracy``), ``heuristics``
+    (one row per heuristic), ``rows`` (all rows, model first), the env config and the model
+    file. Rows are :meth:`EvaluationResult.to_dict` outputs (per-episode curves included).
+    """
+    from frontier_marl.evaluation import evaluate
+    from frontier_marl.policies import ModelPolicy, make_policy
+
+    check_model_env(loaded, cfg)
+    env_kwargs = {"config": cfg}
+    policy = ModelPolicy(loaded.model, name=name, deterministic=True)
+
+    def progress(label: str) -> Callable[[int, Any], None] | None:
+        if on_episode is None:
+            return None
+        return lambda i, _record: on_episode(label, i)
+
+    model_row = evaluate(
+        dict(env_kwargs), policy, episodes=episodes, seed=seed, on_episode=progress(name)
+    ).to_dict()
+    model_row["degeneracy"] = degeneracy(model_row["action_shares"])
+    rows = [model_row]
+    for heuristic in heuristics:
+        row = evaluate(
+            dict(env_kwargs),
+            make_policy(heuristic, seed),
+            episodes=episodes,
+            seed=seed,
+            on_episode=progress(heuristic),
+        ).to_dict()
+        row["degeneracy"] = degeneracy(row["action_shares"])
+        rows.append(row)
+    meta = loaded.metadata or {}
+    return {
+        "model_path": str(loaded.path),
+        "num_timesteps": int(getattr(loaded.model, "num_timesteps", meta.get("num_timesteps", 0))),
+        "deterministic": True,
+        "episodes": episodes,
+        "seed": seed,
+        "env_config": config_to_dict(cfg),
+        "model": model_row,
+        "heuristics": rows[1:],
+        "rows": rows,
+    }
+
+
+def evaluation_env_config(
+    loaded: LoadedModel,
+    preset: str | None = None,
+    overrides: dict[str, Any] | None = None,
+) -> EnvConfig:
+    """The env to evaluate on: the model's training env (from its metadata) with overrides;
+    for a bare SB3 file, ``preset`` (default thesis-20x20) with overrides."""
+    overrides = dict(overrides or {})
+    if loaded.metadata is not None:
+        if preset is not None:
+            base = make_config(preset)
+            saved = env_config_from_metadata(loaded.metadata)
+            # keep the model's observation/reward choices, take the preset's geometry
+            geometry = {k: getattr(base, k) for k in ("height", "width", "perception_range")}
+            return make_config(config=saved, **{**geometry, **overrides})
+        return env_config_from_metadata(loaded.metadata, **overrides)
+    return make_config(preset or "thesis-20x20", **overrides)
+
+
+def format_comparison(result: dict[str, Any]) -> str:
+    """A plain-text table: one line per policy, then the degeneracy verdict."""
+    lines = []
+    header = f"{'policy':<18} {'mean':>8} {'std':>7} {'term.':>7}  action shares"
+    lines.append(header)
+    lines.append("-" * len(header))
+    for row in result["rows"]:
+        shares = " ".join(f"{s:.1%}" for s in row["action_shares"])
+        lines.append(
+            f"{row['policy']:<18} {row['mean_reward']:>8.2f} {row['std_reward']:>7.2f} "
+            f"{row['terminations']:>3}/{row['episodes']:<3}  {shares}"
+        )
+    deg = result["model"]["degeneracy"]
+    verdict = (
+        f"DEGENERATE: action {deg['dominant_action']} in {deg['dominant_share']:.1%} of steps "
+        f"(> {deg['threshold']:.0%})"
+        if deg["degenerate"]
+        else f"not degenerate (most frequent action {deg['dominant_action']}: "
+        f"{deg['dominant_share']:.1%} of steps)"
+    )
+    lines.append(f"model: {verdict}")
+    return "\n".join(lines)

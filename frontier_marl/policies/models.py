@@ -1,0 +1,167 @@
+"""Trained models shipped with the package, usable by name wherever a model path is accepted::
+
+    frontier-marl evaluate thesis-config01
+
+Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN, or
+sb3-contrib MaskablePPO for ``explorer-ppo``) with its
+``model.json`` metadata (env config, observation layout, training run). How each was trained is
+in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``,
+``explorer-dqn``, ``explorer-ppo``, ``team-explorer``).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from importlib import import_module, resources
+from pathlib import Path
+from typing import Any
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.policies.metadata import (
+    check_compatible,
+    env_config_from_metadata,
+    load_metadata,
+)
+from frontier_marl.policies.model_files import MODEL_FILE, list_checkpoints
+
+#: name -> one-line description
+PRETRAINED: dict[str, str] = {
+    "explorer": "the learned frontier selector (docs/beyond-the-thesis.md): a linear, "
+    "permutation-equivariant slot scorer on size-independent slot features with the tour, "
+    "unknown_near and fill features, trained by the cross-entropy method on T99 on five "
+    "benchmark map families by `frontier-marl train explorer` (seed 0); the best-validated "
+    "weights (generation 0 of 12)",
+    "explorer-dqn": "the first learned frontier selector (docs/beyond-the-thesis.md): DQN on a "
+    "masked, permutation-equivariant slot scorer on size-independent slot features, trained on "
+    "the four benchmark map families by `frontier-marl train explorer-dqn` (seed 0); the "
+    "best-validated policy (step 200,000); at parity with nearest-path",
+    "explorer-ppo": "a policy-gradient frontier selector (docs/beyond-the-thesis.md): "
+    "MaskablePPO on the masked, permutation-equivariant slot scorer (MLP actor, pooled "
+    "critic) with the explorer's features and a pure travel cost, trained on five benchmark "
+    "map families by `frontier-marl train explorer-ppo` (seed 0); the best-validated policy "
+    "(step 250,000 of 600,000)",
+    "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
+    "slot scorer with three teammate features per slot, one parameter-shared model for teams "
+    "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
+    "(seed 0); the best-validated policy (step 1,600,032)",
+    "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
+    "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
+    "frontier-marl reproduce run, the seed whose protocol score is the median of the three",
+}
+
+
+def pretrained_names() -> list[str]:
+    return list(PRETRAINED)
+
+
+def pretrained_model_dir(name: str) -> Path:
+    """The folder of shipped model ``name``; ``ValueError`` if unknown or missing."""
+    if name not in PRETRAINED:
+        raise ValueError(f"pretrained model must be one of {pretrained_names()}, got {name!r}")
+    folder = resources.files("frontier_marl").joinpath("assets", "models", name)
+    if not isinstance(folder, Path) or not (folder / "model.zip").is_file():
+        raise ValueError(f"pretrained model {name!r} is missing from the installed package")
+    return folder
+
+
+#: The algorithm recorded in a model's metadata -> the class that loads it (module, name).
+LOADERS: dict[str, tuple[str, str]] = {
+    "DQN": ("stable_baselines3", "DQN"),
+    "PPO": ("stable_baselines3", "PPO"),
+    "MaskablePPO": ("sb3_contrib", "MaskablePPO"),
+}
+
+#: Where models saved before the package's layout of 0.2 find their policy classes: an SB3 zip
+#: names its policy class by module, and these modules moved.
+LEGACY_MODULES: dict[str, str] = {
+    "frontier_marl.training.slot_policy": "frontier_marl.policies.networks.slot_dqn",
+    "frontier_marl.training.slot_actor_critic": "frontier_marl.policies.networks.slot_actor_critic",
+}
+
+
+@dataclass
+class LoadedModel:
+    """An SB3 model with the metadata saved beside it (``None`` for a bare SB3 file)."""
+
+    model: Any
+    path: Path
+    metadata: dict[str, Any] | None
+
+    def env_config(self, **overrides: Any) -> EnvConfig | None:
+        """The training env config with overrides, or ``None`` without metadata."""
+        if self.metadata is None:
+            return None
+        return env_config_from_metadata(self.metadata, **overrides)
+
+
+def resolve_model_path(path: str | Path) -> Path:
+    """``model.zip``, a run folder (its final ``model.zip``), a checkpoint folder, or the name
+    of a model shipped with the package (:data:`PRETRAINED`)."""
+    if str(path) in PRETRAINED and not Path(path).exists():
+        path = pretrained_model_dir(str(path))
+    path = Path(path)
+    if path.is_dir():
+        if (path / MODEL_FILE).is_file():
+            return path / MODEL_FILE
+        checkpoints = list_checkpoints(path)
+        if checkpoints:
+            return checkpoints[-1].model
+        raise ValueError(f"no {MODEL_FILE} in folder {str(path)!r}")
+    if not path.is_file() and path.with_suffix(".zip").is_file():
+        path = path.with_suffix(".zip")
+    if not path.is_file():
+        raise ValueError(f"model file {str(path)!r} not found")
+    return path
+
+
+def loader(label: str | None) -> Any:
+    """The SB3 class that loads a model whose metadata records ``label`` as its algorithm
+    (``None``, a model without metadata: DQN, as every model was before PPO)."""
+    if label is not None and label not in LOADERS:
+        raise ValueError(
+            f"the model's metadata names algorithm {label!r}; known: {sorted(LOADERS)}"
+        )
+    module, name = LOADERS[label or "DQN"]
+    return getattr(import_module(module), name)
+
+
+@contextmanager
+def legacy_module_names() -> Iterator[None]:
+    """Let the policy classes of older model files resolve under their old module names."""
+    added = [old for old in LEGACY_MODULES if old not in sys.modules]
+    for old in added:
+        sys.modules[old] = import_module(LEGACY_MODULES[old])
+    try:
+        yield
+    finally:
+        for old in added:
+            sys.modules.pop(old, None)
+
+
+def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
+    """Load an SB3 model (DQN, PPO or MaskablePPO, by its metadata) and its metadata."""
+    model_path = resolve_model_path(path)
+    metadata = load_metadata(model_path)
+    algorithm = loader(None if metadata is None else metadata.get("algorithm"))
+    with legacy_module_names():
+        model = algorithm.load(model_path, device=device)
+    return LoadedModel(model=model, path=model_path, metadata=metadata)
+
+
+def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:
+    """Raise ``ModelEnvMismatchError`` if the model cannot act in an env built from ``cfg``."""
+    from frontier_marl.envs.parallel import FrontierParallelEnv
+
+    env = FrontierParallelEnv(config=cfg)
+    agent = env.possible_agents[0]
+    check_compatible(
+        cfg,
+        env.observation_space(agent),
+        env.action_space(agent),
+        loaded.model.observation_space,
+        loaded.model.action_space,
+        loaded.metadata,
+    )

@@ -1,0 +1,204 @@
+"""The decision process of N worlds stepped together, for the batched vector env.
+
+:class:`BatchMDP` holds N episodes of ``cfg.n_agents`` robots in shared arrays
+(:class:`~frontier_marl.core.worlds.Worlds`) and applies the rules of
+:class:`~frontier_marl.sim.engine.ExplorationMDP` to all of them at once: actions become targets,
+one compiled call walks every robot, the frontier masks of all worlds whose belief changed are
+labelled by one ``scipy.ndimage.label`` call, one compiled call builds every robot's slots, and
+the reward table, the oscillation test and the observation encoder run on whole arrays. World
+``i`` draws its episodes from its own ``numpy.random.Generator``, so with the same generator
+it plays exactly the episodes of the single-world engine.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import SlotArrays, commit_to_previous
+from frontier_marl.core.worlds import Worlds
+from frontier_marl.sim.episodes import EpisodeSource, world_params
+from frontier_marl.sim.motion import MotionTrail
+from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
+from frontier_marl.sim.rewards import BatchOutcome, OscillationHistory, batch_outcome
+
+Observations = np.ndarray | dict[str, np.ndarray]
+
+
+class BatchMDP:
+    """Frontier-selection MDP of ``n_worlds`` worlds with ``cfg.n_agents`` robots each.
+
+    After :meth:`step` the step's results are in arrays indexed ``[world, robot]``:
+    ``targets``, ``padding``, ``oscillation``, ``new_cells`` and ``outcome`` (rewards, flags,
+    end-reason codes). Worlds whose episode ended stay ``done`` until :meth:`reset_worlds`.
+    """
+
+    def __init__(self, cfg: EnvConfig, n_worlds: int) -> None:
+        if isinstance(n_worlds, bool) or not isinstance(n_worlds, int | np.integer):
+            raise TypeError(f"num_envs must be an integer >= 1, got {n_worlds!r}")
+        if n_worlds < 1:
+            raise ValueError(f"num_envs must be an integer >= 1, got {n_worlds}")
+        n, k = int(n_worlds), cfg.n_agents
+        self.cfg = cfg
+        self.n_worlds, self.n_agents, self.n_slots = n, k, cfg.n_slots
+        self.encoder = ObservationEncoder(cfg)
+        self.worlds = Worlds(cfg.shape, n, k, world_params(cfg))
+        self.source = EpisodeSource(cfg)
+        self.rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(n)]
+        self.slots = SlotArrays.empty(n, k, cfg.n_slots)
+        self._oscillation = OscillationHistory(n, k, cfg.reward.oscillation_window)
+        self._trail = MotionTrail(n, k) if cfg.observation.turn else None
+        self.steps = np.zeros(n, dtype=np.int64)
+        self.steps_without_progress = np.zeros(n, dtype=np.int64)
+        self.done = np.ones(n, dtype=bool)
+        self.targets = np.full((n, k, 2), -1, dtype=np.int64)
+        self.heading = np.full((n, k, 2), -1, dtype=np.int64)  # current targets, -1: none
+        self.padding = np.zeros((n, k), dtype=bool)
+        self.oscillation = np.zeros((n, k), dtype=bool)
+        self.new_cells = np.zeros((n, k), dtype=np.int64)
+        self.outcome = BatchOutcome(
+            np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
+        )
+        self._all = np.arange(n)
+
+    # ------------------------------------------------------------------ episodes
+    def reset_worlds(self, worlds: np.ndarray) -> None:
+        """Start a new episode in each world of ``worlds`` (indices), from its own generator."""
+        for i in worlds.tolist():
+            true_grid, starts, start_region = self.source.draw(self.rngs[i])
+            self.worlds.place(i, true_grid, starts, start_region)
+        self._oscillation.clear(worlds)
+        if self._trail is not None:
+            self._trail.clear(worlds, self.worlds.positions[worlds])
+        self.steps[worlds] = 0
+        self.steps_without_progress[worlds] = 0
+        self.done[worlds] = False
+        self.targets[worlds] = -1
+        self.heading[worlds] = -1
+        self.padding[worlds] = False
+        self.oscillation[worlds] = False
+        self.new_cells[worlds] = 0
+        self.worlds.slots(self.slots, worlds, self.cfg.observation.sort_by_distance)
+
+    # ------------------------------------------------------------------ transition
+    def step(self, actions: np.ndarray, active: np.ndarray) -> None:
+        """One decision per robot of the ``active`` worlds (bool (N,)): ``actions`` (N, K)
+        holds valid slot indices (checked by the caller). Inactive worlds (ended, or waiting
+        while others play forced steps) keep their state: they do not move and get no reward
+        or end flag."""
+        slots = self.slots
+        live = slots.live
+        chosen = actions < live  # live slots come first
+        picked = np.take_along_axis(slots.target, actions[:, :, None, None], axis=2)[:, :, 0]
+        targets = np.where(chosen[..., None], picked, -1)
+        targets[~active] = -1
+        padding = ~chosen & (live > 0) & active[:, None]
+        oscillation = self._oscillation.update(targets, active)
+        worlds = self.worlds
+        before = worlds.travelled.copy()
+        if self._trail is not None:
+            self._trail.push(worlds.positions, active)
+        worlds.move(targets, active)
+        new_cells = np.where(active[:, None], worlds.new_cells, 0)
+        self.steps += active
+        progress = new_cells.any(axis=1)
+        self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + active)
+        indices = self._all[active]
+        worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
+        if self.cfg.observation.commit != "none":
+            slots.mask[:] = commit_to_previous(
+                slots.mask,
+                slots.target,
+                slots.valid,
+                targets,
+                new_cells > 0,
+                self.cfg.observation.commit,
+            )
+        reward = self.cfg.reward
+        fraction = worlds.explored_fraction(reward.threshold_basis)
+        outcome = batch_outcome(
+            reward,
+            new_cells,
+            padding,
+            oscillation,
+            fraction >= reward.explore_threshold,
+            (slots.live == 0).all(axis=1),
+            self.steps,
+            self.steps_without_progress,
+            worlds.travelled - before,
+        )
+        # inactive worlds keep their state: no reward, no new end
+        outcome.rewards[~active] = 0.0
+        outcome.terminated &= active
+        outcome.truncated &= active
+        outcome.reason[~active] = 0
+        self.done |= outcome.terminated | outcome.truncated
+        going = (targets[..., 0] >= 0) & ~worlds.reached
+        # inactive worlds keep their targets, heading and flags
+        moved = active[:, None]
+        heading = np.where(going[..., None], targets, -1)
+        self.heading = np.where(moved[..., None], heading, self.heading)
+        self.targets = np.where(moved[..., None], targets, self.targets)
+        self.padding = np.where(moved, padding, self.padding)
+        self.oscillation = np.where(moved, oscillation, self.oscillation)
+        self.new_cells, self.outcome = new_cells, outcome
+
+    def play_forced(self) -> None:
+        """Step every live world whose robots each have exactly one valid slot (a commitment,
+        or a single cluster) with that slot, until every live world offers a choice or has
+        ended. ``outcome`` then holds the rewards summed since the last decision and the ends
+        reached on the way."""
+        total = self.outcome
+        rewards, reason = total.rewards.copy(), total.reason.copy()
+        terminated, truncated = total.terminated.copy(), total.truncated.copy()
+        while True:
+            forced = ~self.done & (self.slots.mask.sum(axis=2) == 1).all(axis=1)
+            if not forced.any():
+                break
+            self.step(self.slots.mask.argmax(axis=2), forced)
+            step = self.outcome
+            rewards += step.rewards
+            terminated |= step.terminated
+            truncated |= step.truncated
+            reason = np.where(step.reason != 0, step.reason, reason)
+        self.outcome = BatchOutcome(rewards, terminated, truncated, reason)
+
+    # ------------------------------------------------------------------ views
+    def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:
+        """The robots' observations of ``worlds``, ``(len(worlds), K, ...)`` per key."""
+        positions = self.worlds.positions[worlds]
+        shape = positions.shape[:2]
+        count = shape[0] * shape[1]
+        mates = self._teammates(worlds)
+        motion = None if self._trail is None else self._trail.motion(worlds, positions)
+        batch = self.encoder.encode_batch(
+            self.slots.rows(worlds),
+            positions.reshape(count, 2),
+            None if mates is None else mates.reshape(count, -1),
+            self.heading[worlds].reshape(count, 2),
+            None if motion is None else motion.reshape(count, 2),
+            self._beliefs(worlds),
+        )
+        if isinstance(batch, dict):
+            return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}
+        return batch.reshape(*shape, *batch.shape[1:])
+
+    def _beliefs(self, worlds: np.ndarray | slice) -> np.ndarray | None:
+        """The shared belief maps of ``worlds``, for the ``unknown_near`` feature."""
+        if not self.cfg.observation.unknown_near:
+            return None
+        return self.worlds.belief[worlds]
+
+    def _teammates(self, worlds: np.ndarray | slice) -> np.ndarray | None:
+        layout = self.cfg.observation.teammates
+        if layout == "none":
+            return None
+        positions = self.worlds.positions[worlds].astype(np.float64)
+        if layout == "positions":
+            return teammate_rows(positions)
+        heading = observed_heading(self.heading[worlds], self.cfg.observation.features)
+        return teammate_rows(np.concatenate([positions, heading], axis=2))
+
+    def explored_fraction(self, basis: str) -> np.ndarray:
+        """Per world, the explored fraction on ``basis`` (``all``, ``free``, ``reachable``)."""
+        return self.worlds.explored_fraction(basis)

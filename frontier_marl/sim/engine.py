@@ -1,0 +1,248 @@
+"""The decision process shared by the PettingZoo and Gymnasium adapters.
+
+:class:`ExplorationMDP` owns a :class:`~frontier_marl.core.world.World` and turns one action per
+robot (a cluster slot index) into targets, moves the robots, applies the reward table, and
+encodes the next observations. Its step returns typed arrays (:class:`StepResult`); the
+adapters build their info dicts from those (:mod:`frontier_marl.envs.infos`). It holds no RNG of
+its own: ``reset`` takes a ``numpy.random.Generator`` from the adapter, so one seed fixes the
+whole episode.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
+from frontier_marl.core.world import MoveResult, World
+from frontier_marl.sim.episodes import EpisodeSource, world_params
+from frontier_marl.sim.motion import MotionTrail
+from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
+from frontier_marl.sim.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
+
+Observation = np.ndarray | dict[str, np.ndarray]
+
+
+@dataclass(slots=True)
+class StepResult:
+    """One decision step of every robot, as arrays indexed by robot (read-only by convention).
+
+    ``targets`` holds the cell each robot headed for (row -1: it idled); ``padding`` whether it
+    chose a padding slot while a live one existed; ``move`` what the walk did (new cells,
+    paths, whether each robot reached its target); ``outcome`` the rewards and the episode end.
+    """
+
+    observations: list[Observation]
+    targets: np.ndarray  # int (N, 2)
+    padding: np.ndarray  # bool (N,)
+    oscillation: np.ndarray  # bool (N,)
+    move: MoveResult
+    outcome: StepOutcome
+
+    @property
+    def rewards(self) -> np.ndarray:
+        return self.outcome.rewards
+
+    @property
+    def terminated(self) -> bool:
+        return self.outcome.terminated
+
+    @property
+    def truncated(self) -> bool:
+        return self.outcome.truncated
+
+
+class ExplorationMDP:
+    """Frontier-selection MDP for ``cfg.n_agents`` robots on one shared belief grid."""
+
+    def __init__(self, cfg: EnvConfig) -> None:
+        self.cfg = cfg
+        self.encoder = ObservationEncoder(cfg)
+        self.params = world_params(cfg)
+        self.source = EpisodeSource(cfg)
+        self.world: World | None = None
+        self._slot_arrays: SlotArrays | None = None
+        self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
+        self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
+        self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
+        self.last: StepResult | None = None  # the latest step, None right after reset
+        self.steps = 0
+        self.steps_without_progress = 0
+        self.done = True
+
+    # ------------------------------------------------------------------ episode
+    def reset(self, rng: np.random.Generator) -> list[Observation]:
+        """Start an episode: map, start cells (``start_cells``), first sensing."""
+        true_grid, starts, start_region = self.source.draw(rng)
+        self.world = World(true_grid, starts, self.params, start_region)
+        self._oscillation.clear(slice(None))
+        if self._trail is not None:
+            self._trail.clear(slice(None), self.world.positions[None])
+        self.steps = 0
+        self.steps_without_progress = 0
+        self.done = False
+        self.last = None
+        self._refresh_slots()
+        return self._observations(None, None)
+
+    def step(self, actions: list[Any]) -> StepResult:
+        """One decision per robot: ``actions[i]`` is robot i's slot index."""
+        if self.world is None or self.done:
+            raise RuntimeError("step() called before reset() or after the episode ended")
+        cfg = self.cfg
+        n = cfg.n_agents
+        if len(actions) != n:
+            raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
+        slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
+        targets = np.full((n, 2), -1, dtype=np.int64)
+        padding = np.zeros(n, dtype=bool)
+        arrays = self._slot_arrays
+        assert arrays is not None
+        for agent, slot in enumerate(slots):
+            live = arrays.live[agent]
+            if slot < live:  # live slots come first
+                targets[agent] = arrays.target[agent, slot]
+            else:
+                padding[agent] = live > 0
+        oscillation = self._oscillation.update(targets[None])[0]
+        world = self.world
+        before = world.travelled.copy()
+        if self._trail is not None:
+            self._trail.push(world.positions[None], np.ones(1, dtype=bool))
+        moved = world.move(targets)
+        self.steps += 1
+        new_cells = moved.new_cells
+        self.steps_without_progress = 0 if new_cells.any() else self.steps_without_progress + 1
+        self._refresh_slots()
+        assert self._slot_arrays is not None
+        if cfg.observation.commit != "none":
+            arrays = self._slot_arrays
+            arrays.mask[:] = commit_to_previous(
+                arrays.mask,
+                arrays.target,
+                arrays.valid,
+                targets,
+                new_cells > 0,
+                cfg.observation.commit,
+            )
+        fraction = world.explored_fraction(cfg.reward.threshold_basis)
+        outcome = first_outcome(
+            batch_outcome(
+                cfg.reward,
+                new_cells[None],
+                padding[None],
+                oscillation[None],
+                np.array([fraction >= cfg.reward.explore_threshold]),
+                np.array([not self._slot_arrays.live.any()]),
+                np.array([self.steps]),
+                np.array([self.steps_without_progress]),
+                (world.travelled - before)[None],
+            )
+        )
+        self.done = outcome.terminated or outcome.truncated
+        self.last = StepResult(
+            self._observations(targets, moved.reached),
+            targets,
+            padding,
+            oscillation,
+            moved,
+            outcome,
+        )
+        return self.last
+
+    # ------------------------------------------------------------------ helpers
+    def _check_action(self, action: Any, agent: int) -> int:
+        if type(action) is int and 0 <= action < self.cfg.n_slots:  # the common case, fast
+            return action
+        value = action
+        if isinstance(value, np.ndarray):
+            if value.size != 1:
+                raise ValueError(
+                    f"action of robot {agent} must be one integer slot index, "
+                    f"got an array of shape {value.shape}"
+                )
+            value = value.reshape(()).item()
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise TypeError(
+                f"action of robot {agent} must be an integer slot index, "
+                f"got {type(action).__name__} {action!r}"
+            )
+        if not 0 <= value < self.cfg.n_slots:
+            raise ValueError(
+                f"action of robot {agent} must be in [0, {self.cfg.n_slots - 1}] "
+                f"(n_slots={self.cfg.n_slots}), got {value}"
+            )
+        return int(value)
+
+    def _refresh_slots(self) -> None:
+        assert self.world is not None
+        sort = self.cfg.observation.sort_by_distance
+        self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        self._tables = None
+
+    def slot_tables(self) -> list[SlotTable]:
+        """The slot tables the robots observe now (the ones their next actions refer to)."""
+        if self._tables is None:
+            arrays = self._slot_arrays
+            assert arrays is not None
+            self._tables = [arrays.table(agent) for agent in range(self.cfg.n_agents)]
+        return list(self._tables)
+
+    def action_masks(self) -> list[np.ndarray]:
+        """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
+        assert self._slot_arrays is not None
+        return list(self._slot_arrays.mask)
+
+    def _observations(
+        self, targets: np.ndarray | None, reached: np.ndarray | None
+    ) -> list[Observation]:
+        """Every robot's observation; ``targets`` and ``reached`` of the step just taken (None
+        after reset) give the teammates' current targets."""
+        assert self.world is not None
+        positions = self.world.positions
+        heading = self._heading(targets, reached)
+        mates = self._teammate_table(positions, heading)
+        motion = None if self._trail is None else self._trail.motion(0, positions)
+        batch = self.encoder.encode_batch(
+            self._slot_arrays,
+            positions,
+            None if mates is None else teammate_rows(mates),
+            heading,
+            motion,
+            self._beliefs(),
+        )
+        if isinstance(batch, dict):
+            agents = range(self.cfg.n_agents)
+            return [{key: value[agent] for key, value in batch.items()} for agent in agents]
+        return list(batch)
+
+    def _beliefs(self) -> np.ndarray | None:
+        """The robots' shared belief map, (1, H, W), for the ``unknown_near`` feature."""
+        if not self.cfg.observation.unknown_near:
+            return None
+        assert self.world is not None
+        return self.world.belief[None]
+
+    def _heading(self, targets: np.ndarray | None, reached: np.ndarray | None) -> np.ndarray:
+        """(N, 2) the cells the robots are heading to: the step's targets not reached yet
+        (row -1: none, as before the first decision)."""
+        if targets is None or reached is None:
+            return np.full((self.cfg.n_agents, 2), -1, dtype=np.int64)
+        going = (targets[:, 0] >= 0) & ~reached
+        return np.where(going[:, None], targets, -1)
+
+    def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
+        """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:
+        before its first decision, idle, or on its target, see :func:`observed_heading`); None
+        if not observed."""
+        layout = self.cfg.observation.teammates
+        if layout == "none":
+            return None
+        if layout == "positions":
+            return positions.astype(np.float64)
+        heading = observed_heading(heading, self.cfg.observation.features)
+        return np.concatenate([positions, heading], axis=1).astype(np.float64)
