@@ -1,6 +1,6 @@
 """Saving checkpoints of a run (the layout, and reading them:
-:mod:`frontier_marl.policies.model_files`). A checkpoint is written to a temporary folder and renamed, so an interrupted save never leaves a
-half checkpoint behind."""
+:mod:`frontier_marl.policies.model_files`). A checkpoint is written to a temporary folder
+and renamed, so an interrupted save never leaves a half checkpoint behind."""
 
 from __future__ import annotations
 

@@ -49,9 +49,9 @@ class TrainSettings:
             :mod:`frontier_marl.policies.networks.slot_dqn`, trained by ``MaskedDQN``; with PPO the
             actor-critic of :mod:`frontier_marl.policies.networks.slot_actor_critic`.
         families: benchmark map families to train on
-            (:mod:`frontier_marl.evaluation.benchmark.families`), ``n_envs`` worlds of each, their worlds seeded inside each family's training seed
-            range; ``[env]`` then sets the observation and reward (not the map). Empty: the
-            ``[env]`` world.
+            (:mod:`frontier_marl.evaluation.benchmark.families`), ``n_envs`` worlds of each,
+            their worlds seeded inside each family's training seed range; ``[env]`` then
+            sets the observation and reward (not the map). Empty: the ``[env]`` world.
         agents: team sizes to train on with ``families``: ``n_envs`` worlds of every family
             with every team size (one parameter-shared model acts for each robot). The first
             size is the one validated.

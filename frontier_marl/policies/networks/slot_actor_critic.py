@@ -6,10 +6,11 @@ The actor is a slot scorer of :mod:`frontier_marl.policies.networks.slot_dqn` (`
 :class:`~frontier_marl.policies.networks.slot_dqn.LinearSlotScorer`): its per-slot scores are the
 action logits, one shared network for every slot, so reordering the slots reorders the action
 probabilities the same way. Masked slots score
-:data:`~frontier_marl.policies.networks.slot_dqn.MASKED_Q` (-1e9), so they have probability 0 under plain ``PPO`` too; ``MaskablePPO`` masks them once more
-from the env's ``action_masks()``. The critic is its own network: a shared per-slot encoder,
-mean and max pooling over the live slots, and an MLP to the state value (it does not depend on
-the slot order either).
+:data:`~frontier_marl.policies.networks.slot_dqn.MASKED_Q` (-1e9), so they have probability 0
+under plain ``PPO`` too; ``MaskablePPO`` masks them once more from the env's
+``action_masks()``. The critic is its own network: a shared per-slot encoder, mean and max
+pooling over the live slots, and an MLP to the state value (it does not depend on the slot
+order either).
 
     from stable_baselines3 import PPO
     from frontier_marl.policies.networks.slot_actor_critic import SlotActorCriticPolicy
