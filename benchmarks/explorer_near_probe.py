@@ -25,8 +25,9 @@ import numpy as np
 
 from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.sim.features import unknown_near
-from frontier_marl.training.cem import feature_names, play_scorer, relative_t99, weight_vector
+from frontier_marl.training.cem import play_scorer, relative_t99
 from frontier_marl.training.experiment import load_experiment
 
 RULE = {"path": -1.0, "tour": -0.5}

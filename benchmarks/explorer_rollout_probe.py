@@ -26,9 +26,10 @@ from frontier_marl.core.worlds import Worlds
 from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
 from frontier_marl.evaluation.benchmark.run import Contender, contenders, model, run_benchmark
 from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.sim.observations import ObservationEncoder
-from frontier_marl.training.cem import feature_names, shipped_weights, weight_vector
+from frontier_marl.training.cem import shipped_weights
 
 
 class LinearScorerBase:

@@ -29,14 +29,8 @@ from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.sensing import reveal
 from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
-from frontier_marl.training.cem import (
-    changes_text,
-    feature_names,
-    paired_change,
-    play_scorer,
-    shipped_weights,
-    weight_vector,
-)
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.training.cem import changes_text, paired_change, play_scorer, shipped_weights
 from frontier_marl.training.experiment import load_experiment
 
 KINDS = ("true", "belief")

@@ -23,14 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
-from frontier_marl.training.cem import (
-    changes_text,
-    feature_names,
-    paired_change,
-    play_t99,
-    shipped_weights,
-    weight_vector,
-)
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.training.cem import changes_text, paired_change, play_t99, shipped_weights
 from frontier_marl.training.experiment import load_experiment
 
 DIRECTIONS = "lengths:1.25,lengths:1.6,tour:0.8,tour:1.25,unknown_near:0.7,unknown_near:1.4"

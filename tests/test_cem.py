@@ -12,15 +12,10 @@ import torch
 
 from frontier_marl import FrontierParallelEnv
 from frontier_marl.cli.main import main
-from frontier_marl.training.cem import (
-    CEMSettings,
-    feature_names,
-    linear_model,
-    play_t99,
-    relative_t99,
-    save_hand_set,
-)
+from frontier_marl.policies.linear_scorer import feature_names
+from frontier_marl.training.cem import linear_model, play_t99, relative_t99, save_hand_set
 from frontier_marl.training.experiment import load_experiment
+from frontier_marl.training.settings import CEMSettings
 
 CEM_OVERRIDES = [
     "train.algorithm=cem",
@@ -195,8 +190,9 @@ def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
 def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> None:
     import runpy
 
+    from frontier_marl.policies.linear_scorer import weight_vector
     from frontier_marl.sim.features import NEAR
-    from frontier_marl.training.cem import play_scorer, weight_vector
+    from frontier_marl.training.cem import play_scorer
 
     script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_near_probe.py"
     probe = runpy.run_path(str(script))

@@ -118,8 +118,8 @@ def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
 
     from frontier_marl import FrontierParallelEnv
     from frontier_marl.core.slots import SlotArrays
+    from frontier_marl.policies.linear_scorer import feature_names
     from frontier_marl.policies.models import load_model
-    from frontier_marl.training.cem import feature_names
 
     script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
     probe = runpy.run_path(str(script))

@@ -20,93 +20,26 @@ best one is kept in ``RUN/best/``; ``RUN/model.zip`` is the last mean. Both are 
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.sim.features import slot_feature_names
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.training.family_validation import FAILURE
+from frontier_marl.training.results import TrainResult
+from frontier_marl.training.settings import CEMSettings
 
 if TYPE_CHECKING:
     from frontier_marl.envs.vector import FrontierVectorEnv
     from frontier_marl.training.experiment import Experiment
-    from frontier_marl.training.train import TrainResult
 
 LOG_FILE = "cem.jsonl"
-
-
-@dataclass(frozen=True)
-class CEMSettings:
-    """The ``[cem]`` section of an experiment config.
-
-    Attributes:
-        generations: CEM iterations.
-        population: weight vectors tried per generation (the current mean among them).
-        elite: the best of them that the next mean and spread are fitted to.
-        episodes: training episodes per family per generation (fresh every generation).
-        sigma: initial spread of every free weight.
-        min_sigma: floor of the spread (keeps the search from collapsing early).
-        init: initial mean weight by feature name (the others start at 0); must name ``path``,
-            whose weight fixes the scale and is not searched.
-    """
-
-    generations: int = 20
-    population: int = 12
-    elite: int = 4
-    episodes: int = 12
-    sigma: float = 0.3
-    min_sigma: float = 0.03
-    init: Mapping[str, float] = field(default_factory=lambda: {"path": -1.0})
-
-    def __post_init__(self) -> None:
-        for name in ("generations", "population", "elite", "episodes"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"cem.{name} must be an integer >= 1, got {value!r}")
-        if self.elite > self.population:
-            raise ValueError(
-                f"cem.elite ({self.elite}) must not exceed cem.population ({self.population})"
-            )
-        for name in ("sigma", "min_sigma"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
-                raise ValueError(f"cem.{name} must be a number > 0, got {value!r}")
-        if not isinstance(self.init, Mapping) or not isinstance(self.init.get("path"), int | float):
-            raise ValueError(
-                f"cem.init must map feature names to weights with 'path', got {self.init!r}"
-            )
-        if self.init["path"] >= 0:
-            raise ValueError(
-                f"cem.init.path must be < 0 (shorter paths score higher), got {self.init['path']}"
-            )
-
-
-CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
-
-
-def feature_names(cfg: EnvConfig) -> list[str]:
-    """The names of the per-slot features of ``cfg``'s explorer layout, in order."""
-    obs = cfg.observation
-    if obs.features != "explorer":
-        raise ValueError("the linear slot scorer needs features = 'explorer'")
-    return slot_feature_names(obs)
-
-
-def weight_vector(weights: Mapping[str, float], names: list[str], what: str) -> np.ndarray:
-    """``weights`` by feature name as a vector over ``names`` (the others 0); ValueError, naming
-    ``what``, for a name that is not a feature."""
-    unknown = set(weights) - set(names)
-    if unknown:
-        raise ValueError(f"{what} names unknown feature(s) {sorted(unknown)}; features: {names}")
-    return np.array([float(weights.get(name, 0.0)) for name in names])
 
 
 def initial_weights(settings: CEMSettings, names: list[str]) -> np.ndarray:
@@ -266,7 +199,6 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
     from frontier_marl.policies.metadata import save_metadata
     from frontier_marl.training.family_validation import FamilyValidator
     from frontier_marl.training.plots import plot_family_validation
-    from frontier_marl.training.train import TrainResult
     from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
     from frontier_marl.utils.progress import progress_bar as make_bar
 

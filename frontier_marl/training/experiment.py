@@ -17,7 +17,7 @@ A config file has four parts (every one optional except ``name``)::
     seed = 0
 
 and, with ``train.algorithm = "cem"``, a ``[cem]`` section instead of ``[dqn]``
-(:class:`~frontier_marl.training.cem.CEMSettings`); with ``"ppo"`` or ``"maskable-ppo"``, a
+(:class:`~frontier_marl.training.settings.CEMSettings`); with ``"ppo"`` or ``"maskable-ppo"``, a
 ``[ppo]`` section (keyword arguments of SB3's ``PPO`` or sb3-contrib's ``MaskablePPO``, their
 defaults where unset) and no ``[dqn]``.
 
@@ -30,7 +30,6 @@ are parsed as TOML (``1e-4``, ``true``, ``[64, 64]``), else kept as strings.
 from __future__ import annotations
 
 import dataclasses
-import math
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -39,18 +38,16 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_keys, make_config
-from frontier_marl.config.thesis import DQN_HYPERPARAMETERS
 from frontier_marl.core.example_maps import EXAMPLE_MAPS, example_map_path
-from frontier_marl.training.algorithms import SECTION, keyword_names
-from frontier_marl.training.cem import CEM_KEYS, CEMSettings, feature_names, weight_vector
-from frontier_marl.training.settings import TRAIN_KEYS, TrainSettings
+from frontier_marl.evaluation.benchmark.families import family, variant_configs
+from frontier_marl.training.algorithms import SB3_ALGORITHMS
+from frontier_marl.training.dqn import DQN, THESIS_DQN
+from frontier_marl.training.ppo import PPO, with_prior_vector
+from frontier_marl.training.settings import CEM_KEYS, TRAIN_KEYS, CEMSettings, TrainSettings
 
 __all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
 
 SECTIONS = ("env", "dqn", "ppo", "train", "cem")
-
-#: The thesis's final DQN hyperparameters; everything else is SB3's default.
-THESIS_DQN = DQN_HYPERPARAMETERS
 
 
 @dataclass(frozen=True)
@@ -72,13 +69,7 @@ class Experiment:
         observation's slot features (ValueError for a name that is not one)."""
         if not self._uses_ppo():
             return self.dqn
-        policy_kwargs = self.ppo.get("policy_kwargs", {})
-        prior = policy_kwargs.get("prior") if isinstance(policy_kwargs, Mapping) else None
-        if not isinstance(prior, Mapping):
-            return self.ppo
-        names = feature_names(self.env_config())
-        vector = weight_vector(prior, names, "ppo.policy_kwargs.prior").tolist()
-        return {**self.ppo, "policy_kwargs": {**policy_kwargs, "prior": vector}}
+        return with_prior_vector(self.ppo, self.env_config())
 
     def env_config(self) -> EnvConfig:
         """The validated env config (raises ``ValueError`` naming a bad env key); with
@@ -89,8 +80,6 @@ class Experiment:
         """One env config per training family and team size (``[env]`` on each family's world
         with ``train.agents`` robots, families first), or the ``[env]`` config alone."""
         if self.train.families:
-            from frontier_marl.evaluation.benchmark.families import family, variant_configs
-
             return [
                 variant_configs(family(name), self.env, agents)[0]
                 for name in self.train.families
@@ -116,12 +105,18 @@ class Experiment:
         }
 
     def _uses_ppo(self) -> bool:
-        return SECTION.get(self.train.algorithm) == "ppo"
+        return section_of(self.train.algorithm) == "ppo"
+
+
+def section_of(algorithm: str) -> str | None:
+    """The config section of ``algorithm``'s keywords (None for ``cem``)."""
+    sb3 = SB3_ALGORITHMS.get(algorithm)
+    return None if sb3 is None else sb3.section
 
 
 def dqn_keys() -> set[str]:
     """Keyword arguments of ``stable_baselines3.DQN`` that a config may set."""
-    return keyword_names("dqn")
+    return DQN.keyword_names()
 
 
 def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> Experiment:
@@ -159,19 +154,20 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
             f"unknown or reserved [dqn] key(s) {sorted(bad_dqn)}{where}; "
             f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
         )
-    _check_ranges("dqn", dqn, where)
+    DQN.check_ranges(dqn, where)
     settings = TrainSettings(**train_kw)
     ppo = dict(data.get("ppo", {}))
     _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
     if ppo:
-        allowed = keyword_names(settings.algorithm)
+        algorithm = SB3_ALGORITHMS[settings.algorithm]
+        allowed = algorithm.keyword_names()
         unknown = set(ppo) - allowed
         if unknown:
             raise ValueError(
                 f"unknown or reserved [ppo] key(s) {sorted(unknown)}{where}; "
                 f"allowed: {sorted(allowed)} (seed and device are set in [train])"
             )
-        _check_ranges("ppo", ppo, where)
+        algorithm.check_ranges(ppo, where)
     cem = dict(data.get("cem", {}))
     bad_cem = set(cem) - CEM_KEYS
     if bad_cem:
@@ -205,7 +201,7 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
 def _check_sections(algorithm: str, has_dqn: bool, has_ppo: bool, where: str) -> None:
     """A ``[dqn]`` or ``[ppo]`` section that ``algorithm`` would not read is an error (it
     would be silently ignored)."""
-    section = SECTION.get(algorithm)
+    section = section_of(algorithm)
     if has_ppo and section != "ppo":
         raise ValueError(
             f"[ppo] settings{where} are read only with train.algorithm = 'ppo' or "
@@ -216,64 +212,6 @@ def _check_sections(algorithm: str, has_dqn: bool, has_ppo: bool, where: str) ->
             f"[dqn] settings{where} are not read with train.algorithm = {algorithm!r}: "
             "set PPO's keywords in [ppo] (ppo.key=value)"
         )
-
-
-#: Ranges of the settings checked before SB3 sees them: key -> (kind, low, high); first the
-#: keywords DQN and PPO share, then each one's own.
-_SHARED_RANGES: dict[str, tuple[str, float, float]] = {
-    "learning_rate": ("float", 0.0, math.inf),
-    "gamma": ("float", 0.0, 1.0),
-    "max_grad_norm": ("float", 0.0, math.inf),
-    "batch_size": ("int", 1, math.inf),
-    "n_steps": ("int", 1, math.inf),
-}
-_RANGES: dict[str, dict[str, tuple[str, float, float]]] = {
-    "dqn": {
-        **_SHARED_RANGES,
-        "exploration_fraction": ("float", 0.0, 1.0),
-        "exploration_initial_eps": ("float", 0.0, 1.0),
-        "exploration_final_eps": ("float", 0.0, 1.0),
-        "tau": ("float", 0.0, 1.0),
-        "buffer_size": ("int", 1, math.inf),
-        "learning_starts": ("int", 0, math.inf),
-        "target_update_interval": ("int", 1, math.inf),
-        "train_freq": ("int", 1, math.inf),
-        "gradient_steps": ("int", -1, math.inf),
-    },
-    "ppo": {
-        **_SHARED_RANGES,
-        "n_epochs": ("int", 1, math.inf),
-        "gae_lambda": ("float", 0.0, 1.0),
-        "clip_range": ("float", 0.0, math.inf),
-        "ent_coef": ("float", 0.0, math.inf),
-        "vf_coef": ("float", 0.0, math.inf),
-    },
-}
-
-
-def _check_ranges(section: str, values: Mapping[str, Any], where: str) -> None:
-    for key, (kind, low, high) in _RANGES[section].items():
-        if key not in values:
-            continue
-        value = values[key]
-        if kind == "int":
-            ok = isinstance(value, int) and not isinstance(value, bool)
-            if key == "train_freq" and isinstance(value, list | tuple) and len(value) == 2:
-                ok, value = isinstance(value[0], int) and value[1] in ("step", "episode"), value[0]
-            what = "an integer"
-        else:
-            ok = isinstance(value, int | float) and not isinstance(value, bool)
-            ok = ok and math.isfinite(value)
-            what = "a number"
-        if not ok or not low <= value <= high:
-            bounds = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
-            raise ValueError(f"{section}.{key} must be {what} {bounds}, got {values[key]!r}{where}")
-    if values.get("learning_rate", 1.0) == 0:
-        raise ValueError(f"{section}.learning_rate must be > 0{where}")
-    if values.get("gradient_steps", 1) == 0:
-        raise ValueError(f"{section}.gradient_steps must be >= 1 or -1, got 0{where}")
-    if values.get("clip_range", 1.0) == 0:
-        raise ValueError(f"{section}.clip_range must be > 0{where}")
 
 
 def parse_override(text: str) -> tuple[str, str, Any]:
@@ -295,7 +233,7 @@ def parse_override(text: str) -> tuple[str, str, Any]:
         for section, keys in (
             ("train", TRAIN_KEYS),
             ("dqn", dqn_keys()),
-            ("ppo", keyword_names("ppo") - dqn_keys()),
+            ("ppo", PPO.keyword_names() - dqn_keys()),
             ("cem", CEM_KEYS),
             ("env", set(config_keys())),
         )

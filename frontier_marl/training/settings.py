@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
@@ -157,3 +158,52 @@ class TrainSettings:
 
 
 TRAIN_KEYS = {f.name for f in dataclasses.fields(TrainSettings)}
+
+
+@dataclass(frozen=True)
+class CEMSettings:
+    """The ``[cem]`` section of an experiment config.
+
+    Attributes:
+        generations: CEM iterations.
+        population: weight vectors tried per generation (the current mean among them).
+        elite: the best of them that the next mean and spread are fitted to.
+        episodes: training episodes per family per generation (fresh every generation).
+        sigma: initial spread of every free weight.
+        min_sigma: floor of the spread (keeps the search from collapsing early).
+        init: initial mean weight by feature name (the others start at 0); must name ``path``,
+            whose weight fixes the scale and is not searched.
+    """
+
+    generations: int = 20
+    population: int = 12
+    elite: int = 4
+    episodes: int = 12
+    sigma: float = 0.3
+    min_sigma: float = 0.03
+    init: Mapping[str, float] = field(default_factory=lambda: {"path": -1.0})
+
+    def __post_init__(self) -> None:
+        for name in ("generations", "population", "elite", "episodes"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"cem.{name} must be an integer >= 1, got {value!r}")
+        if self.elite > self.population:
+            raise ValueError(
+                f"cem.elite ({self.elite}) must not exceed cem.population ({self.population})"
+            )
+        for name in ("sigma", "min_sigma"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+                raise ValueError(f"cem.{name} must be a number > 0, got {value!r}")
+        if not isinstance(self.init, Mapping) or not isinstance(self.init.get("path"), int | float):
+            raise ValueError(
+                f"cem.init must map feature names to weights with 'path', got {self.init!r}"
+            )
+        if self.init["path"] >= 0:
+            raise ValueError(
+                f"cem.init.path must be < 0 (shorter paths score higher), got {self.init['path']}"
+            )
+
+
+CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}

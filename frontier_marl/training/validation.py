@@ -22,7 +22,7 @@ from typing import Any
 from frontier_marl.config import EnvConfig
 from frontier_marl.policies.metadata import load_metadata, save_metadata
 from frontier_marl.policies.model_files import MODEL_FILE
-from frontier_marl.training.experiment import TrainSettings
+from frontier_marl.training.settings import TrainSettings
 
 BEST_DIR = "best"
 LOG_FILE = "validation.jsonl"

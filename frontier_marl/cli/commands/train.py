@@ -149,7 +149,7 @@ def run(args: argparse.Namespace) -> int:
         f"{settings.total_timesteps} steps, seed {settings.seed}, {worlds} ({settings.vec_env})"
     )
     if settings.algorithm == "cem":
-        from frontier_marl.training.cem import CEMSettings
+        from frontier_marl.training.settings import CEMSettings
 
         cem = CEMSettings(**experiment.cem)
         budget = (
