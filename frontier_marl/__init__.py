@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from pettingzoo.utils.conversions import parallel_to_aec
+
 from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
 from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
 from frontier_marl.envs.registration import GYM_ID, PETTINGZOO_ID, register_envs
@@ -29,8 +31,6 @@ def parallel_env(**kwargs: Any) -> FrontierParallelEnv:
 
 def raw_env(**kwargs: Any) -> Any:
     """The AEC form of :func:`parallel_env`, without extra wrappers."""
-    from pettingzoo.utils.conversions import parallel_to_aec
-
     return parallel_to_aec(parallel_env(**kwargs))
 
 

@@ -7,7 +7,9 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from frontier_marl.config import PRESETS
+from frontier_marl.config import PRESETS, make_config
+from frontier_marl.core.example_maps import example_map_names
+from frontier_marl.policies import POLICIES
 
 
 def int_at_least(low: int) -> Callable[[str], int]:
@@ -100,7 +102,6 @@ def add_env_arguments(parser: argparse.ArgumentParser) -> None:
         default="thesis-20x20",
         help="thesis geometry (default: %(default)s)",
     )
-    from frontier_marl.core.example_maps import example_map_names
 
     parser.add_argument(
         "--map",
@@ -143,8 +144,6 @@ def add_env_arguments(parser: argparse.ArgumentParser) -> None:
 
 def env_kwargs_from_args(args: argparse.Namespace) -> dict[str, Any]:
     """Env keyword arguments from the shared options, validated (ValueError if invalid)."""
-    from frontier_marl.config import make_config
-
     kwargs: dict[str, Any] = {"preset": args.preset}
     overrides = parse_set_options(args.overrides)
     for reserved in ("preset", "config"):
@@ -176,7 +175,6 @@ def fail(command: str, message: str) -> int:
 
 
 def parse_policies(text: str) -> list[str]:
-    from frontier_marl.policies import POLICIES
 
     names = [name.strip() for name in text.split(",") if name.strip()]
     if not names:

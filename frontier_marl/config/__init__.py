@@ -17,6 +17,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Literal, get_args
 
+from frontier_marl.core.map_files import load_map
 from frontier_marl.utils.checks import (
     check_bool,
     check_choice,
@@ -436,7 +437,6 @@ def _apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
 
 
 def _shape_from_map_file(path: str, overrides: dict[str, Any]) -> dict[str, int]:
-    from frontier_marl.core.map_files import load_map
 
     try:
         height, width = load_map(path).shape

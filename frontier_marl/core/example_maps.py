@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from frontier_marl.core.maps import rooms_map
+
 #: name -> (height, width, seed of ``rooms_map``)
 EXAMPLE_MAPS: dict[str, tuple[int, int, int]] = {
     "rooms-32": (32, 32, 32),
@@ -52,8 +54,6 @@ def example_map_path(name: str) -> Path:
 
 def generate_example_map(name: str) -> np.ndarray:
     """The layout of example map ``name`` drawn afresh from the generator (True = wall)."""
-    from frontier_marl.core.maps import rooms_map
-
     if name not in EXAMPLE_MAPS:
         raise ValueError(f"example map must be one of {example_map_names()}, got {name!r}")
     height, width, seed = EXAMPLE_MAPS[name]

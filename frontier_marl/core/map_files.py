@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import imageio.v3 as iio
 import numpy as np
 
 FREE_LEVEL = 250
@@ -121,7 +122,6 @@ def parse_pgm(data: bytes, name: str = "<pgm>") -> np.ndarray:
 
 
 def _load_png(path: Path) -> np.ndarray:
-    import imageio.v3 as iio
 
     raw = np.asarray(iio.imread(path))
     if raw.dtype == bool:

@@ -10,6 +10,9 @@ behaviour changes.
 
 from __future__ import annotations
 
+import gymnasium
+import pettingzoo
+
 from frontier_marl.config import PRESETS
 
 GYM_ID = "frontier_marl/FrontierExplore-v0"
@@ -31,9 +34,6 @@ VARIANTS: dict[str, dict[str, str]] = {
 
 def register_envs() -> None:
     """Register every id with Gymnasium and PettingZoo (Parallel and AEC); idempotent."""
-    import gymnasium
-    import pettingzoo
-
     for env_id, kwargs in VARIANTS.items():
         if env_id not in gymnasium.registry:
             gymnasium.register(

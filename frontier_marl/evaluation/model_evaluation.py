@@ -12,6 +12,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
+from frontier_marl.evaluation import evaluate
+from frontier_marl.policies import ModelPolicy, make_policy
 from frontier_marl.policies.metadata import env_config_from_metadata
 from frontier_marl.policies.models import LoadedModel, check_model_env
 
@@ -52,9 +54,6 @@ def evaluate_model(
     (one row per heuristic), ``rows`` (all rows, model first), the env config and the model
     file. Rows are :meth:`EvaluationResult.to_dict` outputs (per-episode curves included).
     """
-    from frontier_marl.evaluation import evaluate
-    from frontier_marl.policies import ModelPolicy, make_policy
-
     check_model_env(loaded, cfg)
     env_kwargs = {"config": cfg}
     policy = ModelPolicy(loaded.model, name=name, deterministic=True)

@@ -43,6 +43,7 @@ import numbers
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 from frontier_marl.evaluation.metrics import (
@@ -66,7 +67,6 @@ class _TeamView:
     """Runs a ParallelEnv or a single-robot Gymnasium env through one dict-based interface."""
 
     def __init__(self, env: Any) -> None:
-        import gymnasium as gym
 
         self.env = env
         self.single = isinstance(env, gym.Env)

@@ -13,7 +13,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.config import make_config
+from frontier_marl.config.thesis import heuristic_baseline
+from frontier_marl.evaluation import evaluate
+from frontier_marl.policies import make_policy
 from frontier_marl.utils.json_files import json_safe
+from frontier_marl.utils.progress import progress_bar
 
 DEFAULT_POLICIES = "greedy-distance,greedy-gain,cost-utility,random"
 
@@ -26,12 +31,6 @@ def run_baselines(
     progress: bool = True,
 ) -> list[dict[str, Any]]:
     """Evaluate each heuristic; one JSON-able row per policy (see ``EvaluationResult``)."""
-    from frontier_marl.config import make_config
-    from frontier_marl.config.thesis import heuristic_baseline
-    from frontier_marl.evaluation import evaluate
-    from frontier_marl.policies import make_policy
-    from frontier_marl.utils.progress import progress_bar
-
     cfg = make_config(**env_kwargs)
     preset = str(env_kwargs.get("preset", "thesis-20x20"))
     # The thesis's figures are shown for its geometry (size, range) with one robot only.
@@ -124,7 +123,6 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
 
 
 def describe(env_kwargs: dict[str, Any], episodes: int, seed: int) -> str:
-    from frontier_marl.config import make_config
 
     cfg = make_config(**env_kwargs)
     if cfg.map_path is not None:

@@ -16,6 +16,9 @@ folders; the table is built from the reported results either way.
 
 Re-running a campaign into the same ``out`` reuses finished runs (their ``evaluation.json``)
 and resumes interrupted ones from their newest checkpoint.
+
+Ray and the training modules are imported where they are used: Ray is an optional extra, and
+the CLI imports this module to build its parser.
 """
 
 from __future__ import annotations
@@ -35,7 +38,17 @@ from frontier_marl.experiments.ray_tune import (
     flat_scalars,
     require_ray,
 )
-from frontier_marl.experiments.results import SUMMARY_COLUMNS, sort_rows, summary_row, write_table
+from frontier_marl.experiments.results import (
+    SUMMARY_COLUMNS,
+    run_summary,
+    sort_rows,
+    summary_row,
+    training_wall_time,
+    write_table,
+)
+from frontier_marl.policies.metadata import load_metadata
+from frontier_marl.policies.model_files import list_checkpoints
+from frontier_marl.training.experiment import experiment_from_dict, load_experiment
 
 __all__ = ["CampaignResult", "RayNotInstalledError", "TrialSpec", "build_grid", "run_campaign"]
 
@@ -81,8 +94,6 @@ def build_grid(
     overrides: Sequence[str] = (),
 ) -> list[TrialSpec]:
     """Load and validate every config (``ValueError`` on a bad one) and list the trials."""
-    from frontier_marl.training.experiment import load_experiment
-
     for name, values, low in (("seeds", seeds, 0), ("steps", budgets, 1)):
         if not values:
             raise ValueError(f"--{name} must list at least one value")
@@ -120,9 +131,6 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
     A run folder that already holds a finished run with ``evaluation.json`` for this budget
     and number of episodes is reused; one with a checkpoint is resumed.
     """
-    from frontier_marl.experiments.results import run_summary, training_wall_time
-    from frontier_marl.policies.model_files import list_checkpoints
-    from frontier_marl.training.experiment import experiment_from_dict
     from frontier_marl.training.train import resume_experiment, train
 
     started = time.perf_counter()
@@ -167,9 +175,6 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
 
 def _check_same_experiment(run_dir: Path, spec: TrialSpec) -> None:
     """Refuse to reuse or resume a run folder that holds another experiment's run."""
-    from frontier_marl.policies.metadata import load_metadata
-    from frontier_marl.policies.model_files import list_checkpoints
-
     sources = [run_dir / "model.zip", *(c.model for c in list_checkpoints(run_dir)[-1:])]
     for model in sources:
         meta = load_metadata(model) if model.is_file() else None

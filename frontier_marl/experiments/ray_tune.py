@@ -15,6 +15,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.utils.progress import progress_bar
+
 RAY_HINT = 'Ray Tune is not installed: pip install "frontier-marl[ray]"'
 
 
@@ -112,7 +114,6 @@ def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
             return {**self.__dict__, "bar": None}
 
         def setup(self, **info: Any) -> None:
-            from frontier_marl.utils.progress import progress_bar
 
             self.bar = progress_bar(
                 len(self.names), unit="trial", disable=not self.progress, desc="campaign"

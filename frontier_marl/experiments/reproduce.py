@@ -23,6 +23,9 @@ heuristic baselines on the same env and the same episodes with
 The acceptance checks ask every seed's policy to be genuine and the mean over all seeds'
 episodes to reach 13.1. ``resume=True`` continues interrupted runs from their newest
 checkpoints (or re-evaluates finished ones); a seed with nothing to continue starts fresh.
+
+The training modules (torch, SB3) are imported where they are used: the CLI imports this
+module to build its parser, and ``frontier-marl --help`` should not wait for torch.
 """
 
 from __future__ import annotations
@@ -32,12 +35,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.evaluation.plots import plot_baselines
+from frontier_marl.experiments.baselines import dumps_rows, run_baselines
 from frontier_marl.experiments.comparison import (
     comparison_table,
     format_comparison_markdown,
     reported_evaluation,
 )
+from frontier_marl.policies.model_files import find_checkpoint, list_checkpoints
+from frontier_marl.training.experiment import load_experiment
+from frontier_marl.training.plots import plot_action_comparison, plot_learning_curves
+from frontier_marl.training.validation import read_validation_log
 from frontier_marl.utils.checks import check_int
+from frontier_marl.utils.json_files import write_json
 
 DEFAULT_CONFIG = "config01"
 #: Seeds trained by default: at least three runs, to report their spread (docs/results.md).
@@ -83,9 +94,7 @@ def reproduce(
     """Train every seed (``jobs`` at a time, default all), evaluate and compare (see the
     module docstring). Raises ``ValueError`` on bad input or when ``out`` already holds a run
     and ``resume`` is false; nothing is trained then."""
-    from frontier_marl.experiments.baselines import dumps_rows, run_baselines
     from frontier_marl.training.workers import train_runs
-    from frontier_marl.utils.json_files import write_json
 
     steps = check_int("steps", steps, 1)
     seeds = _check_seeds(seeds)
@@ -148,8 +157,6 @@ def _train_job(
     log: Callable[[str], None],
 ) -> Any:
     """The training job of one seed: a fresh run, or the run in ``out`` to resume."""
-    from frontier_marl.policies.model_files import find_checkpoint, list_checkpoints
-    from frontier_marl.training.experiment import load_experiment
     from frontier_marl.training.train import resume_experiment
     from frontier_marl.training.workers import TrainJob
 
@@ -177,8 +184,6 @@ def _train_job(
 def _warm_kernels(experiment: Any) -> None:
     """One reset and step of the env, so the compiled kernels are on disk before several
     worker processes load them at once."""
-    from frontier_marl.envs.parallel import FrontierParallelEnv
-
     env = FrontierParallelEnv(config=experiment.env_config())
     env.reset(seed=0)
     env.step({agent: 0 for agent in env.agents})
@@ -193,10 +198,7 @@ def _figures(
     trained: Sequence[Any],
     name: str,
 ) -> dict[str, Path]:
-    from frontier_marl.evaluation.plots import plot_baselines
     from frontier_marl.training.callbacks import read_metrics
-    from frontier_marl.training.plots import plot_action_comparison, plot_learning_curves
-    from frontier_marl.training.validation import read_validation_log
 
     dqn = table["rows"][0]
     setting, training = table["setting"], table["training"]

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config.thesis import dqn_result_text
+from frontier_marl.utils.json_files import write_json
 
 #: Columns of a summary table, in order.
 SUMMARY_COLUMNS: tuple[str, ...] = (
@@ -183,8 +184,6 @@ def write_table(
     extra: Mapping[str, Any] | None = None,
 ) -> dict[str, Path]:
     """``STEM.md``, ``STEM.csv`` and ``STEM.json`` (``{"rows": [...], **extra}``)."""
-    from frontier_marl.utils.json_files import write_json
-
     stem = Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
     md = stem.with_suffix(".md")

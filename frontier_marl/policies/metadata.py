@@ -13,8 +13,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from gymnasium import spaces
 
+import frontier_marl
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
 from frontier_marl.sim.observations import describe_layout
 
@@ -57,8 +59,6 @@ def build_metadata(
     import stable_baselines3
     import supersuit
     import torch
-
-    import frontier_marl
 
     return {
         "format": METADATA_FORMAT,
@@ -148,7 +148,6 @@ def check_compatible(
 
 
 def _jsonable(value: Any) -> Any:
-    import numpy as np
 
     if isinstance(value, np.generic):
         return value.item()

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.policies.metadata import (
     check_compatible,
     env_config_from_metadata,
@@ -153,8 +154,6 @@ def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
 
 def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:
     """Raise ``ModelEnvMismatchError`` if the model cannot act in an env built from ``cfg``."""
-    from frontier_marl.envs.parallel import FrontierParallelEnv
-
     env = FrontierParallelEnv(config=cfg)
     agent = env.possible_agents[0]
     check_compatible(

@@ -36,6 +36,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from frontier_marl.policies.base import (
     Info,
@@ -153,7 +154,6 @@ class CoordinatedAssignment(TeamHeuristic):
     name = "coordinated-assignment"
 
     def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
-        from scipy.optimize import linear_sum_assignment
 
         n = len(options)
         if n == 1:

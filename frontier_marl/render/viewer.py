@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
+import imageio.v3 as iio
 import numpy as np
 
 
@@ -71,8 +72,6 @@ def write_gif(frames: list[np.ndarray], path: str | os.PathLike, fps: float = 4.
         if f.shape != first:
             raise ValueError(f"frames[{i}] has shape {f.shape}, expected {first}")
     data = np.stack(stack).astype(np.uint8, copy=False)
-
-    import imageio.v3 as iio
 
     iio.imwrite(
         os.fspath(path),

@@ -11,6 +11,8 @@ from typing import Any
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.logger import KVWriter
 
+from frontier_marl.utils.progress import progress_bar
+
 
 class Periodic(BaseCallback):
     """Calls ``action(model)`` every ``every`` environment steps, counted from step 0 (so a
@@ -55,7 +57,6 @@ class ProgressBar(BaseCallback):
         self._next = 0
 
     def _on_training_start(self) -> None:
-        from frontier_marl.utils.progress import progress_bar
 
         total = int(self.locals["total_timesteps"])
         self._shown = self.model.num_timesteps

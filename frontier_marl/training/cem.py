@@ -28,12 +28,22 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import torch
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.envs.vector import FrontierVectorEnv
+from frontier_marl.evaluation.benchmark.families import family
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
-from frontier_marl.training.family_validation import FAILURE
+from frontier_marl.policies.metadata import build_metadata, save_metadata
+from frontier_marl.policies.models import pretrained_model_dir
+from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
+from frontier_marl.training.batched_vec_env import make_batched_vec_env
+from frontier_marl.training.family_validation import FAILURE, FamilyValidator
+from frontier_marl.training.plots import plot_family_validation
 from frontier_marl.training.results import TrainResult
 from frontier_marl.training.settings import CEMSettings
+from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
+from frontier_marl.utils.progress import progress_bar as make_bar
 
 if TYPE_CHECKING:
     from frontier_marl.envs.vector import FrontierVectorEnv
@@ -62,8 +72,6 @@ def play_scorer(
     """:func:`play_t99` with any slot scorer: ``score(observations, env)`` gives the (N,
     n_slots) scores of the N episodes' slots (``env`` for scorers that read more than the
     observation, e.g. the belief maps); the valid slot of highest score is taken."""
-    from frontier_marl.envs.vector import FrontierVectorEnv
-
     if cfg.n_agents != 1:
         raise ValueError("the cross-entropy method trains one robot (train.agents = [1])")
     env = FrontierVectorEnv(num_envs=len(seeds), config=cfg, skip_forced_steps=True)
@@ -109,8 +117,6 @@ def changes_text(changes: Mapping[str, Mapping[str, float]]) -> str:
 
 def shipped_weights(name: str = "explorer") -> dict[str, float]:
     """The weights by feature name of the shipped linear scorer ``name``."""
-    from frontier_marl.policies.models import pretrained_model_dir
-
     return json.loads((pretrained_model_dir(name) / "model.json").read_text())["weights"]
 
 
@@ -132,9 +138,6 @@ def candidate_score(
 
 def linear_model(cfg: EnvConfig, weights: np.ndarray, device: str = "cpu") -> Any:
     """A ``MaskedDQN`` whose linear slot scorer holds ``weights`` (for saving and validation)."""
-    from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
-    from frontier_marl.training.batched_vec_env import make_batched_vec_env
-
     env = make_batched_vec_env({"config": cfg}, 1)
     model = MaskedDQN(
         SlotDQNPolicy,
@@ -154,8 +157,6 @@ def linear_metadata(
 ) -> dict[str, Any]:
     """The ``model.json`` of a linear slot scorer: the usual metadata, its weights by feature
     name, and ``extra`` (e.g. ``trained_by``)."""
-    from frontier_marl.policies.metadata import build_metadata
-
     current = model.policy.q_net.q_net.weight.detach().cpu().numpy()
     weights = {name: float(w) for name, w in zip(feature_names(cfg), current, strict=True)}
     return build_metadata(
@@ -172,8 +173,6 @@ def linear_metadata(
 def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experiment) -> None:
     """Save a linear slot scorer with hand-set ``weights`` (by feature name, the others 0) on
     ``experiment``'s observation as a model folder (``model.zip`` and ``model.json``)."""
-    from frontier_marl.policies.metadata import save_metadata
-
     cfg = experiment.env_config()
     model = linear_model(cfg, weight_vector(weights, feature_names(cfg), "hand-set weights"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -184,7 +183,6 @@ def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experi
 
 
 def set_weights(model: Any, weights: np.ndarray) -> None:
-    import torch
 
     value = torch.as_tensor(weights, dtype=torch.float32)
     with torch.no_grad():
@@ -195,13 +193,6 @@ def set_weights(model: Any, weights: np.ndarray) -> None:
 def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) -> TrainResult:
     """Run CEM for ``experiment`` into ``run_dir`` (summary in ``RUN/cem.json``, one record
     per generation in ``RUN/cem.jsonl``)."""
-    from frontier_marl.evaluation.benchmark.families import family
-    from frontier_marl.policies.metadata import save_metadata
-    from frontier_marl.training.family_validation import FamilyValidator
-    from frontier_marl.training.plots import plot_family_validation
-    from frontier_marl.training.validation import BestPolicyKeeper, read_validation_log
-    from frontier_marl.utils.progress import progress_bar as make_bar
-
     settings, cem = experiment.train, CEMSettings(**experiment.cem)
     configs = experiment.env_configs()
     cfg = configs[0]

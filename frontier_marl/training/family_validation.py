@@ -28,6 +28,7 @@ from frontier_marl.evaluation.benchmark.families import (
 )
 from frontier_marl.evaluation.benchmark.run import Contender, default_commit, heuristic, run_family
 from frontier_marl.evaluation.records import level_key
+from frontier_marl.policies.base import ModelPolicy
 
 FAILURE = 1.0  # the relative T99 difference an episode that never reached 99 % counts as
 REFERENCE = "nearest-path"
@@ -64,7 +65,6 @@ class FamilyValidator:
         ]
 
     def _contender(self, model: Any) -> Contender:
-        from frontier_marl.policies.base import ModelPolicy
 
         def config(world: EnvConfig) -> EnvConfig:
             return make_config(None, **{**world_settings(world), **self._own})

@@ -21,6 +21,7 @@ import numpy as np
 import torch as th
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.evaluation.benchmark.families import COVERAGE
 from frontier_marl.policies.lookahead import lookahead_costs
 from frontier_marl.sim.features import CELLS
@@ -109,8 +110,6 @@ def collect(
     on_episode: Callable[[], None] | None = None,
 ) -> None:
     """Episodes ``seeds[i]`` of config ``configs[i]`` into ``data`` (see :func:`play`)."""
-    from frontier_marl.envs.parallel import FrontierParallelEnv
-
     for cfg, family_seeds in zip(configs, seeds, strict=True):
         env = FrontierParallelEnv(config=cfg)
         try:

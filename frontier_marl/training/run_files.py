@@ -4,21 +4,25 @@
 from __future__ import annotations
 
 import json
+import os
+import platform
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
+from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
+
+from frontier_marl.training.callbacks import JsonLinesWriter, read_metrics, truncate_metrics
 from frontier_marl.training.experiment import Experiment
+from frontier_marl.training.plots import plot_family_validation
+from frontier_marl.training.plots import plot_learning_curve as plot
+from frontier_marl.training.validation import read_validation_log
 
 
 def set_logger(model: Any, run_dir: Path, start_step: int, resumed: bool, verbose: int) -> None:
     """TensorBoard (``RUN/tb``), ``RUN/metrics.jsonl`` (cut back to ``start_step`` on resume)
     and, with ``verbose``, the console."""
-    from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
-
-    from frontier_marl.training.callbacks import JsonLinesWriter, truncate_metrics
-
     metrics = run_dir / "metrics.jsonl"
     if resumed:
         truncate_metrics(metrics, start_step)
@@ -66,11 +70,6 @@ def record_session(
 def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: int) -> Path:
     """``RUN/learning_curve.png`` from the run's metrics and validation logs (and, for a run
     validated on map families, ``RUN/validation_t99.png``)."""
-    from frontier_marl.training.callbacks import read_metrics
-    from frontier_marl.training.plots import plot_family_validation
-    from frontier_marl.training.plots import plot_learning_curve as plot
-    from frontier_marl.training.validation import read_validation_log
-
     path = run_dir / "learning_curve.png"
     title = f"{experiment.name} (seed {experiment.train.seed}, {num_timesteps} steps)"
     validation = read_validation_log(run_dir)
@@ -83,9 +82,6 @@ def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: in
 def machine_name() -> str:
     """The CPU model (from ``/proc/cpuinfo`` where there is one) and the core count: training
     results depend on the CPU (docs/results.md)."""
-    import os
-    import platform
-
     model = platform.processor() or platform.machine()
     cpuinfo = Path("/proc/cpuinfo")
     if cpuinfo.is_file():

@@ -20,6 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.evaluation import evaluate
+from frontier_marl.policies import ModelPolicy
 from frontier_marl.policies.metadata import load_metadata, save_metadata
 from frontier_marl.policies.model_files import MODEL_FILE
 from frontier_marl.training.settings import TrainSettings
@@ -72,8 +74,6 @@ class BestPolicyKeeper:
             shutil.rmtree(self.best_dir)
 
     def _mean_reward(self, model: Any) -> dict[str, Any]:
-        from frontier_marl.evaluation import evaluate
-        from frontier_marl.policies import ModelPolicy
 
         result = evaluate(
             {"config": self.cfg},

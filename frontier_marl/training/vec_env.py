@@ -27,7 +27,9 @@ import warnings
 from typing import Any
 
 import numpy as np
+import supersuit as ss
 from pettingzoo.utils.wrappers import BaseParallelWrapper
+from stable_baselines3.common.vec_env import VecMonitor
 
 from frontier_marl.envs.parallel import FrontierParallelEnv
 
@@ -82,9 +84,6 @@ def make_vec_env(
     ``bootstrap_truncations=False`` SB3 treats truncations as terminal (see
     :class:`TimeLimitInfo`).
     """
-    import supersuit as ss
-    from stable_baselines3.common.vec_env import VecMonitor
-
     if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
         raise ValueError(f"n_envs must be an integer >= 1, got {n_envs!r}")
     markov = ss.pettingzoo_env_to_vec_env_v1(make_parallel_env(env_kwargs, bootstrap_truncations))

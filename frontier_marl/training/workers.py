@@ -25,7 +25,10 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.policies.model_files import Checkpoint
+from frontier_marl.training.callbacks import Periodic
 from frontier_marl.training.experiment import Experiment
+from frontier_marl.training.train import train
+from frontier_marl.utils.progress import progress_bar
 
 #: How often (environment steps) a worker reports its progress and looks for a stop request.
 REPORT_EVERY = 1000
@@ -60,7 +63,6 @@ def train_runs(jobs: Sequence[TrainJob], workers: int, progress: bool = True) ->
 
 
 def _train_here(jobs: Sequence[TrainJob], progress: bool) -> TrainOutcome:
-    from frontier_marl.training.train import train
 
     results: list[Any] = []
     for job in jobs:
@@ -86,9 +88,6 @@ def _init_worker(reports: Any, stop: Any) -> None:
 
 def _run_job(index: int, job: TrainJob) -> Any:
     """Train one job in a worker; None when a stop was requested before it started."""
-    from frontier_marl.training.callbacks import Periodic
-    from frontier_marl.training.train import train
-
     if _STOP.is_set():
         return None
 
@@ -161,7 +160,6 @@ class _Bars:
         self._bars: list[Any] = []
         if not progress:
             return
-        from frontier_marl.utils.progress import progress_bar
 
         for i, job in enumerate(jobs):
             start = 0 if job.checkpoint is None else job.checkpoint.step

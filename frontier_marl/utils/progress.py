@@ -10,11 +10,11 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from tqdm import tqdm
+
 
 def progress_bar(total: int | None = None, *, disable: bool = False, **kwargs: Any) -> Any:
     """A ``tqdm`` bar over ``total`` items on standard error (keyword arguments go to tqdm)."""
-    from tqdm import tqdm
-
     stream = kwargs.pop("file", sys.stderr)
     options: dict[str, Any] = {"file": stream, "dynamic_ncols": True}
     if not _is_terminal(stream):

@@ -27,6 +27,11 @@ from frontier_marl.cli.arguments import (
     parse_set_options,
     positive_int,
 )
+from frontier_marl.evaluation.benchmark import families as map_families
+from frontier_marl.evaluation.benchmark import run as bench
+from frontier_marl.evaluation.benchmark.families import DEFAULT_EPISODES, FAMILIES, SPLITS
+from frontier_marl.evaluation.benchmark.stats import format_table, plot_benchmark
+from frontier_marl.utils.json_files import write_json
 
 #: The default heuristics: the thesis's two, cost-utility and nearest-path; teams add the joint
 #: ones.
@@ -35,7 +40,6 @@ TEAM_HEURISTICS = ("coordinated-assignment", "utility-discount")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.evaluation.benchmark.families import DEFAULT_EPISODES, FAMILIES, SPLITS
 
     parser.add_argument(
         "--families",
@@ -100,10 +104,6 @@ def _names(text: str | None) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.evaluation.benchmark import families as map_families
-    from frontier_marl.evaluation.benchmark import run as bench
-    from frontier_marl.evaluation.benchmark.stats import format_table, plot_benchmark
-    from frontier_marl.utils.json_files import write_json
 
     try:
         names = _names(args.families)

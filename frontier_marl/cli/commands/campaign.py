@@ -21,6 +21,10 @@ import argparse
 import sys
 from pathlib import Path
 
+from frontier_marl.cli.arguments import add_set_argument, fail, int_list, positive_int
+from frontier_marl.experiments.campaign import RayNotInstalledError, run_campaign
+from frontier_marl.experiments.results import format_markdown
+
 
 def _positive_float(text: str) -> float:
     try:
@@ -33,7 +37,6 @@ def _positive_float(text: str) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.cli.arguments import add_set_argument, int_list, positive_int
 
     parser.add_argument(
         "--configs",
@@ -99,9 +102,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.cli.arguments import fail
-    from frontier_marl.experiments.campaign import RayNotInstalledError, run_campaign
-    from frontier_marl.experiments.results import format_markdown
 
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     try:

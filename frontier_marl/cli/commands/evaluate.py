@@ -20,11 +20,25 @@ import argparse
 import sys
 from pathlib import Path
 
+from frontier_marl.cli.arguments import (
+    add_set_argument,
+    non_negative_int,
+    parse_policies,
+    parse_set_options,
+    positive_int,
+)
 from frontier_marl.config import PRESETS
+from frontier_marl.evaluation.model_evaluation import (
+    evaluate_model,
+    evaluation_env_config,
+    format_comparison,
+)
+from frontier_marl.policies.metadata import ModelEnvMismatchError
+from frontier_marl.policies.models import load_model
+from frontier_marl.utils.progress import progress_bar
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.cli.arguments import add_set_argument, non_negative_int, positive_int
 
     parser.add_argument(
         "model",
@@ -93,14 +107,6 @@ def _fail(message: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.cli.arguments import parse_policies, parse_set_options
-    from frontier_marl.evaluation.model_evaluation import (
-        evaluate_model,
-        evaluation_env_config,
-        format_comparison,
-    )
-    from frontier_marl.policies.metadata import ModelEnvMismatchError
-    from frontier_marl.policies.models import load_model
 
     try:
         overrides = parse_set_options(args.overrides)
@@ -119,8 +125,6 @@ def run(args: argparse.Namespace) -> int:
             f"{args.preset or 'thesis-20x20'} with the given overrides",
             file=sys.stderr,
         )
-
-    from frontier_marl.utils.progress import progress_bar
 
     total = args.episodes * (1 + len(heuristics))
     with progress_bar(total, disable=args.no_progress, unit="ep") as bar:

@@ -17,16 +17,21 @@ from typing import Any
 
 import numpy as np
 
+import frontier_marl
 from frontier_marl.cli.arguments import (
     add_env_arguments,
     env_kwargs_from_args,
     fail,
     positive_int,
 )
+from frontier_marl.config import make_config
+from frontier_marl.evaluation.benchmark.run import contenders
+from frontier_marl.policies import POLICIES
+from frontier_marl.render.renderer import frame
+from frontier_marl.render.viewer import write_gif
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.policies import POLICIES
 
     parser.add_argument(
         "--policy",
@@ -66,8 +71,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def render_frame(env: Any, cell_px: int) -> np.ndarray:
     """An RGB frame of ``env``'s current state at ``cell_px`` pixels per cell (the same
     picture as ``env.render()`` in ``rgb_array`` mode, which is fixed at 12 px)."""
-    from frontier_marl.render.renderer import frame
-
     return frame(env.unwrapped.mdp, "rgb_array", cell_px=cell_px)
 
 
@@ -80,10 +83,6 @@ def record_episode(
 ) -> tuple[list[np.ndarray], float, int, str]:
     """Frames (reset included), team-mean return, decision steps and end reason of one
     episode of ``policy_name`` (a heuristic, or a model on its own observation settings)."""
-    import frontier_marl
-    from frontier_marl.config import make_config
-    from frontier_marl.evaluation.benchmark.run import contenders
-
     contender = contenders([policy_name])[0]
     cfg = contender.config(make_config(**env_kwargs))
     env = frontier_marl.parallel_env(render_mode="rgb_array", config=cfg)
@@ -132,7 +131,6 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--fps must be > 0, got {args.fps}")
     except ValueError as exc:
         return fail("gif", str(exc))
-    from frontier_marl.render.viewer import write_gif
 
     names = [args.policy] + ([args.beside] if args.beside else [])
     episodes = []

@@ -26,10 +26,12 @@ import argparse
 import sys
 from pathlib import Path
 
+from frontier_marl.cli.arguments import fail, int_list, positive_int
+from frontier_marl.experiments.comparison import format_comparison_markdown
+from frontier_marl.experiments.reproduce import DEFAULT_SEEDS, reproduce
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.cli.arguments import int_list, positive_int
-    from frontier_marl.experiments.reproduce import DEFAULT_SEEDS
 
     parser.add_argument(
         "--steps",
@@ -130,9 +132,6 @@ def _print_summary(result: object) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from frontier_marl.cli.arguments import fail
-    from frontier_marl.experiments.comparison import format_comparison_markdown
-    from frontier_marl.experiments.reproduce import reproduce
 
     try:
         result = reproduce(

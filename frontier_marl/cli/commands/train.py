@@ -22,9 +22,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.cli.arguments import add_set_argument, non_negative_int, positive_int
+from frontier_marl.evaluation.model_evaluation import format_comparison
+from frontier_marl.policies.model_files import find_checkpoint
+from frontier_marl.training.experiment import load_experiment, parse_override
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from frontier_marl.cli.arguments import add_set_argument, non_negative_int, positive_int
 
     parser.add_argument(
         "config",
@@ -78,7 +82,6 @@ def _fail(message: str) -> int:
 
 
 def _fresh(args: argparse.Namespace) -> tuple[Any, Path, None]:
-    from frontier_marl.training.experiment import load_experiment
     from frontier_marl.training.train import default_run_dir
 
     if args.config is None:
@@ -93,8 +96,6 @@ def _fresh(args: argparse.Namespace) -> tuple[Any, Path, None]:
 
 
 def _resumed(args: argparse.Namespace) -> tuple[Any, Path, Any]:
-    from frontier_marl.policies.model_files import find_checkpoint
-    from frontier_marl.training.experiment import load_experiment, parse_override
     from frontier_marl.training.train import resume_experiment
 
     checkpoint = find_checkpoint(args.resume)
@@ -130,7 +131,6 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         return _fail(str(exc))
 
-    from frontier_marl.evaluation.model_evaluation import format_comparison
     from frontier_marl.training.train import train
 
     cfg = experiment.env_config()

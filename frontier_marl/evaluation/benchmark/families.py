@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, ObservationConfig, config_to_dict, make_config
+from frontier_marl.core.example_maps import resolve_map
 
 #: Held-out episode seeds of every family (episode i: seed 900_000 + i); never used for
 #: training, validation or tuning.
@@ -137,8 +138,6 @@ def check_families(names: Any, what: str = "families") -> None:
 def map_files(paths: Sequence[str | Path]) -> list[str]:
     """The map files named by ``paths``: files as given, folders as their sorted .pgm/.png/.txt
     files, names of the package's example maps as their files."""
-    from frontier_marl.core.example_maps import resolve_map
-
     files: list[str] = []
     for given in paths:
         path = Path(resolve_map(str(given)))

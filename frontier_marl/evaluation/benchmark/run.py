@@ -24,12 +24,14 @@ Statistics (T99, T90, success, the paired difference to the best heuristic) are 
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
+from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.evaluation.benchmark.families import (
     COVERAGE,
     DEFAULT_EPISODES,
@@ -39,8 +41,15 @@ from frontier_marl.evaluation.benchmark.families import (
     variant_configs,
     world_settings,
 )
+from frontier_marl.evaluation.benchmark.stats import compare, summary_row
+from frontier_marl.evaluation.protocol import evaluate
 from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
-from frontier_marl.policies.base import Policy
+from frontier_marl.policies.base import ModelPolicy, Policy
+from frontier_marl.policies.lookahead import LookaheadOracle
+from frontier_marl.policies.metadata import ModelEnvMismatchError
+from frontier_marl.policies.models import PRETRAINED, check_model_env, load_model
+from frontier_marl.policies.registry import POLICIES, make_policy
+from frontier_marl.utils.progress import progress_bar
 
 ORACLE = "lookahead-oracle"
 
@@ -67,17 +76,12 @@ def default_commit(agents: int) -> str:
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
     """A heuristic of the registry, with ``commit`` (``random`` has no commit rule)."""
-    from frontier_marl.policies.registry import make_policy
-
     options = {} if name == "random" else {"commit": commit}
     return Contender(name, True, lambda: make_policy(name, 0, **options), lambda cfg: cfg)
 
 
 def model(name: str) -> Contender:
     """A saved or shipped SB3 model (``thesis-config01``, a run folder, a model.zip)."""
-    from frontier_marl.policies.base import ModelPolicy
-    from frontier_marl.policies.models import check_model_env, load_model
-
     try:
         loaded = load_model(name)
     except Exception as exc:  # e.g. a file that is not an SB3 zip
@@ -99,17 +103,12 @@ def model(name: str) -> Contender:
 def oracle() -> Contender:
     """``lookahead-oracle`` (:mod:`frontier_marl.policies.lookahead`): it reads the true map,
     so it is reported beside the others but never counts as the best heuristic."""
-    from frontier_marl.policies.lookahead import LookaheadOracle
-
     return Contender(LookaheadOracle.name, False, LookaheadOracle, lambda cfg: cfg)
 
 
 def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Contender]:
     """Heuristics by name, ``lookahead-oracle`` and models by name or path; ValueError for
     anything else."""
-    from frontier_marl.policies.models import PRETRAINED
-    from frontier_marl.policies.registry import POLICIES
-
     out = []
     for name in names:
         if name in POLICIES:
@@ -168,11 +167,6 @@ def run_family(
     """``episodes`` episodes of ``split`` (:meth:`MapFamily.seeds`) of one policy on one
     family (``worlds`` from :func:`variant_configs`); the result's ``extra`` holds the family,
     maps and seeds."""
-    import time
-
-    from frontier_marl.envs.parallel import FrontierParallelEnv
-    from frontier_marl.evaluation.protocol import evaluate
-
     start = time.perf_counter()
     seeds = fam.seeds(episodes, split)
     configs = [contender.config(world) for world in worlds]
@@ -227,10 +221,6 @@ def run_benchmark(
     the comparison to the family's best heuristic
     (:func:`~frontier_marl.evaluation.benchmark.stats.compare`). A model that cannot act on a
     family (e.g. another map size) is skipped there, with a note to ``log``."""
-    from frontier_marl.evaluation.benchmark.stats import compare, summary_row
-    from frontier_marl.policies.metadata import ModelEnvMismatchError
-    from frontier_marl.utils.progress import progress_bar
-
     if len({fam.name for fam in families}) < len(families):
         raise ValueError(f"family names must be distinct, got {[f.name for f in families]}")
     worlds = [variant_configs(fam, overrides, agents) for fam in families]

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.evaluation.metrics import mean_std
+from frontier_marl.evaluation.plots import _pyplot
 from frontier_marl.evaluation.records import EvaluationResult, level_key
 
 
@@ -240,8 +241,6 @@ def plot_benchmark(
     """A PNG with one panel per family: T99 mean per policy with std error bars, the success
     count above each bar (hatched where some episodes failed: the mean is over the
     successful ones), the family's best heuristic in green."""
-    from frontier_marl.evaluation.plots import _pyplot
-
     if not rows:
         raise ValueError("rows must not be empty")
     plt = _pyplot()
