@@ -1,6 +1,6 @@
 """DQN training with Stable-Baselines3 (training/README.md).
 
-* :mod:`~frontier_marl.training.experiment`: TOML experiment configs (``training/*.toml``);
+* :mod:`~frontier_marl.training.experiment`: TOML experiment configs (``assets/configs/*.toml``);
   :mod:`~frontier_marl.training.settings` their ``[train]`` section.
 * :mod:`~frontier_marl.training.batched_vec_env`: the batched vector env as an SB3 ``VecEnv``
   (the default), and ``MixedVecEnv`` for several map families.
