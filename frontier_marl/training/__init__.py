@@ -1,19 +1,26 @@
-"""DQN training with Stable-Baselines3 (training/README.md).
+"""Training learned frontier selectors (training/README.md): one module per algorithm and a
+dispatcher.
 
-* :mod:`~frontier_marl.training.experiment`: TOML experiment configs (``assets/configs/*.toml``);
-  :mod:`~frontier_marl.training.settings` their ``[train]`` section.
+* :mod:`~frontier_marl.training.experiment`: TOML experiment configs
+  (``frontier_marl/assets/configs/*.toml``); :mod:`~frontier_marl.training.settings` their
+  ``[train]`` and ``[cem]`` sections.
+* :mod:`~frontier_marl.training.train`: the dispatcher (run folder, resume) over the algorithms.
+* :mod:`~frontier_marl.training.dqn`, :mod:`~frontier_marl.training.ppo`: the SB3 algorithms'
+  classes and settings; :mod:`~frontier_marl.training.sb3_session` runs a session of either
+  (learn, checkpoints, Ctrl-C, evaluation).
+* :mod:`~frontier_marl.training.cem`: the cross-entropy method on the linear slot scorer.
+* :mod:`~frontier_marl.training.imitation`: DAgger labels from the lookahead oracle and the fit
+  of a slot Q-network to them (``benchmarks/imitation_probe.py``).
 * :mod:`~frontier_marl.training.batched_vec_env`: the batched vector env as an SB3 ``VecEnv``
-  (the default), and ``MixedVecEnv`` for several map families.
-* :mod:`~frontier_marl.training.vec_env`: ParallelEnv -> SuperSuit -> SB3 vector env.
-* :mod:`~frontier_marl.policies.networks.slot_dqn`: the masked, permutation-equivariant slot
-  Q-network and ``MaskedDQN`` (the ``explorer``).
-* :mod:`~frontier_marl.training.family_validation`: T99 validation on map families (a
-  team: the makespan against utility-discount).
-* :mod:`~frontier_marl.training.imitation`: DAgger labels from the lookahead oracle and the
-  fit of a slot Q-network to them (``benchmarks/imitation_probe.py``).
-* :mod:`~frontier_marl.training.train`: the training loop, checkpoints, resume, Ctrl-C.
-* :mod:`~frontier_marl.evaluation.model_evaluation`: thesis evaluation of a saved model.
-* :mod:`~frontier_marl.policies.metadata`: what is saved beside a model, and the mismatch check.
+  (the default), and ``MixedVecEnv`` for several map families;
+  :mod:`~frontier_marl.training.vec_env`: ParallelEnv -> SuperSuit -> SB3 vector env.
+* :mod:`~frontier_marl.training.validation`, :mod:`~frontier_marl.training.family_validation`:
+  the best-validated policy (mean reward, or T99 on map families).
+* :mod:`~frontier_marl.training.checkpoints`, :mod:`~frontier_marl.training.run_files`,
+  :mod:`~frontier_marl.training.callbacks`, :mod:`~frontier_marl.training.plots`: what a run
+  writes.
+* :mod:`~frontier_marl.training.workers`: several runs side by side in worker processes.
 
-Submodules import torch / SB3 lazily where they can; import them directly.
+The networks are in :mod:`frontier_marl.policies.networks` (loading a model needs them, and
+training is above the policies); these modules need the ``train`` extra.
 """
