@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from pettingzoo.utils.conversions import parallel_to_aec
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
 from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
 from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
@@ -30,13 +31,14 @@ def parallel_env(**kwargs: Any) -> FrontierParallelEnv:
 
 
 def raw_env(**kwargs: Any) -> Any:
-    """The AEC form of :func:`parallel_env`, without extra wrappers."""
-    return parallel_to_aec(parallel_env(**kwargs))
+    """The AEC form of :func:`parallel_env`, unwrapped (PettingZoo's ``raw_env`` convention)."""
+    return parallel_to_aec_wrapper(parallel_env(**kwargs))
 
 
 def env(**kwargs: Any) -> Any:
-    """The PettingZoo AEC env (order-enforced), converted from :func:`parallel_env`."""
-    return raw_env(**kwargs)
+    """The PettingZoo AEC env: :func:`raw_env` in PettingZoo's ``OrderEnforcingWrapper``
+    (an error for stepping before ``reset``, or reading a dead agent's data)."""
+    return OrderEnforcingWrapper(raw_env(**kwargs))
 
 
 register_envs()

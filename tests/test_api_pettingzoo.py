@@ -119,3 +119,19 @@ def test_metadata() -> None:
     assert env.metadata["name"] == "frontier_explore_v0"
     assert set(env.metadata["render_modes"]) == {"human", "rgb_array", "ansi"}
     assert env.metadata["is_parallelizable"] is True
+
+
+@pytest.mark.parametrize("kwargs", CASES)
+def test_raw_env_is_the_unwrapped_aec_env_and_env_enforces_the_order(
+    kwargs: dict[str, Any],
+) -> None:
+    from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+    from pettingzoo.utils.wrappers import BaseWrapper, OrderEnforcingWrapper
+
+    raw = frontier_marl.raw_env(**kwargs)
+    assert isinstance(raw, parallel_to_aec_wrapper) and not isinstance(raw, BaseWrapper)
+    api_test(raw, num_cycles=50)
+    wrapped = frontier_marl.env(**kwargs)
+    assert isinstance(wrapped, OrderEnforcingWrapper)
+    with pytest.raises(AssertionError, match="reset"):
+        wrapped.step(0)  # before reset: the wrapper names what is missing

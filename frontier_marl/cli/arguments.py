@@ -175,7 +175,6 @@ def fail(command: str, message: str) -> int:
 
 
 def parse_policies(text: str) -> list[str]:
-
     names = [name.strip() for name in text.split(",") if name.strip()]
     if not names:
         raise ValueError(f"--policies must name at least one of {list(POLICIES)}")

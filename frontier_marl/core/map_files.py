@@ -122,7 +122,6 @@ def parse_pgm(data: bytes, name: str = "<pgm>") -> np.ndarray:
 
 
 def _load_png(path: Path) -> np.ndarray:
-
     raw = np.asarray(iio.imread(path))
     if raw.dtype == bool:
         levels = raw.astype(np.float64) * 255.0

@@ -67,7 +67,6 @@ class _TeamView:
     """Runs a ParallelEnv or a single-robot Gymnasium env through one dict-based interface."""
 
     def __init__(self, env: Any) -> None:
-
         self.env = env
         self.single = isinstance(env, gym.Env)
         if self.single:

@@ -123,7 +123,6 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
 
 
 def describe(env_kwargs: dict[str, Any], episodes: int, seed: int) -> str:
-
     cfg = make_config(**env_kwargs)
     if cfg.map_path is not None:
         layout = f"file {Path(cfg.map_path).name}"

@@ -114,7 +114,6 @@ def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
             return {**self.__dict__, "bar": None}
 
         def setup(self, **info: Any) -> None:
-
             self.bar = progress_bar(
                 len(self.names), unit="trial", disable=not self.progress, desc="campaign"
             )

@@ -148,7 +148,6 @@ def check_compatible(
 
 
 def _jsonable(value: Any) -> Any:
-
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):

@@ -154,7 +154,6 @@ class CoordinatedAssignment(TeamHeuristic):
     name = "coordinated-assignment"
 
     def choose_team(self, options: list[list[_Option]]) -> list[_Option | None]:
-
         n = len(options)
         if n == 1:
             return [_nearest(options[0])]

@@ -57,7 +57,6 @@ class ProgressBar(BaseCallback):
         self._next = 0
 
     def _on_training_start(self) -> None:
-
         total = int(self.locals["total_timesteps"])
         self._shown = self.model.num_timesteps
         self._next = self._shown + self.every

@@ -183,7 +183,6 @@ def save_hand_set(weights: Mapping[str, float], folder: Path, experiment: Experi
 
 
 def set_weights(model: Any, weights: np.ndarray) -> None:
-
     value = torch.as_tensor(weights, dtype=torch.float32)
     with torch.no_grad():
         for network in (model.policy.q_net, model.policy.q_net_target):

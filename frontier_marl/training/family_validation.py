@@ -65,7 +65,6 @@ class FamilyValidator:
         ]
 
     def _contender(self, model: Any) -> Contender:
-
         def config(world: EnvConfig) -> EnvConfig:
             return make_config(None, **{**world_settings(world), **self._own})
 

@@ -74,7 +74,6 @@ class BestPolicyKeeper:
             shutil.rmtree(self.best_dir)
 
     def _mean_reward(self, model: Any) -> dict[str, Any]:
-
         result = evaluate(
             {"config": self.cfg},
             ModelPolicy(model, name="validation", deterministic=True),

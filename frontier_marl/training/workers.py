@@ -63,7 +63,6 @@ def train_runs(jobs: Sequence[TrainJob], workers: int, progress: bool = True) ->
 
 
 def _train_here(jobs: Sequence[TrainJob], progress: bool) -> TrainOutcome:
-
     results: list[Any] = []
     for job in jobs:
         result = train(job.experiment, job.run_dir, resume=job.checkpoint, progress_bar=progress)

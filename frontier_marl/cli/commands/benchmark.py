@@ -40,7 +40,6 @@ TEAM_HEURISTICS = ("coordinated-assignment", "utility-discount")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "--families",
         default=None,
@@ -104,7 +103,6 @@ def _names(text: str | None) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-
     try:
         names = _names(args.families)
         if args.families is not None and not names:

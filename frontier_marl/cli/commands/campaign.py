@@ -37,7 +37,6 @@ def _positive_float(text: str) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "--configs",
         default="config01",
@@ -102,7 +101,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     try:
         result = run_campaign(

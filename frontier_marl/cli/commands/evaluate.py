@@ -39,7 +39,6 @@ from frontier_marl.utils.progress import progress_bar
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "model",
         metavar="MODEL",
@@ -107,7 +106,6 @@ def _fail(message: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-
     try:
         overrides = parse_set_options(args.overrides)
         if args.map_mode is not None:

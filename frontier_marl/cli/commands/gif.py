@@ -32,7 +32,6 @@ from frontier_marl.render.viewer import write_gif
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "--policy",
         default="greedy-distance",

@@ -32,7 +32,6 @@ from frontier_marl.experiments.reproduce import DEFAULT_SEEDS, reproduce
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "--steps",
         type=positive_int,
@@ -132,7 +131,6 @@ def _print_summary(result: object) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     try:
         result = reproduce(
             args.out,

@@ -29,7 +29,6 @@ from frontier_marl.training.experiment import load_experiment, parse_override
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "config",
         nargs="?",
