@@ -59,3 +59,12 @@ def info_with(live: Sequence[dict[str, Any]], n_slots: int = 4, **extra: Any) ->
     """A robot's info holding ``slot_table(live)`` and its action mask."""
     table = slot_table(live, n_slots)
     return {"slots": table, "action_mask": table.mask, **extra}
+
+
+def silent(model: Any) -> Any:
+    """``model`` with a logger that writes nothing (SB3's default makes a ``SB3-*`` folder in
+    the temp directory on every ``learn``)."""
+    from stable_baselines3.common.logger import Logger
+
+    model.set_logger(Logger(folder=None, output_formats=[]))
+    return model

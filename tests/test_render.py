@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import numpy as np
@@ -147,20 +146,15 @@ def test_paths_and_targets() -> None:
     render_rgb(TRUE, BELIEF, positions, targets=np.array([[-1, -1]]), cell_px=PX)
 
 
-def test_large_map_small_cells_and_speed() -> None:
+def test_large_map_small_cells() -> None:
     rng = np.random.default_rng(0)
     true = rng.random((128, 128)) < 0.2
     belief = np.where(rng.random((128, 128)) < 0.5, UNKNOWN, true.astype(np.int8)).astype(np.int8)
     labels = rng.integers(0, 4, size=(128, 128))
     positions = rng.integers(0, 128, size=(4, 2))
     frame = render_rgb(true, belief, positions, labels, cell_px=4)
-    assert frame.shape == (512, 1028, 3)
-    t0, t1 = true[:20, :20], belief[:20, :20]
-    render_rgb(t0, t1, positions % 20, labels[:20, :20], np.array([[3.5, 4.0]] * 3))
-    start = time.perf_counter()
-    for _ in range(10):
-        render_rgb(t0, t1, positions % 20, labels[:20, :20], np.array([[3.5, 4.0]] * 3))
-    assert (time.perf_counter() - start) / 10 < 0.05  # generous bound for slow CI machines
+    assert frame.shape == (512, 1028, 3)  # two 128 x 4 px panels and a 4 px gap
+    assert np.array_equal(frame[:4, :4], np.broadcast_to(frame[0, 0], (4, 4, 3)))  # one cell
 
 
 def test_render_ansi_exact() -> None:
@@ -222,16 +216,26 @@ def test_render_ansi_value_errors() -> None:
         render_ansi(BELIEF, NO_ROBOTS, np.zeros((2, 2), dtype=int))
 
 
-def test_human_viewer_headless() -> None:
+def test_human_viewer_shows_each_frame_in_its_own_figure_and_closes_it() -> None:
     matplotlib = pytest.importorskip("matplotlib")
     matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
     frame = render_rgb(TRUE, BELIEF, NO_ROBOTS, cell_px=2)
-    viewer = HumanViewer()
-    viewer.fps = 1000.0
+    first, second = HumanViewer(fps=1000.0), HumanViewer(fps=1000.0)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        viewer.show(frame)
-        viewer.show(frame[::-1].copy())
-        viewer.show(render_rgb(TRUE, BELIEF, NO_ROBOTS, cell_px=3))
-    viewer.close()
-    viewer.close()
+        # Agg draws off screen; matplotlib says so when asked to pause
+        warnings.filterwarnings("ignore", message=".*non-interactive", category=UserWarning)
+        first.show(frame)
+        second.show(frame[::-1].copy())
+        assert first._fig is not second._fig  # one figure per viewer
+        assert np.array_equal(first._im.get_array(), frame)
+        assert np.array_equal(second._im.get_array(), frame[::-1])
+        larger = render_rgb(TRUE, BELIEF, NO_ROBOTS, cell_px=3)
+        first.show(larger)  # a new shape replaces the image
+        assert np.array_equal(first._im.get_array(), larger)
+    number = first._fig.number
+    first.close()
+    assert not plt.fignum_exists(number) and plt.fignum_exists(second._fig.number)
+    first.close()  # closing twice is safe
+    second.close()

@@ -22,6 +22,10 @@ from frontier_marl.policies.networks.slot_actor_critic import (
 )
 from frontier_marl.training.batched_vec_env import make_batched_vec_env
 from frontier_marl.training.experiment import experiment_from_dict, parse_override
+from tests.helpers import silent
+
+#: The MaskablePPO research model of the explorer studies (in the repository, not the wheel)
+EXPLORER_PPO = Path(__file__).resolve().parents[1] / "training" / "models" / "explorer-ppo"
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown", "reward": "travel"}
 CLASSES = [(PPO, SlotActorCriticPolicy), (MaskablePPO, MaskableSlotActorCriticPolicy)]
@@ -68,7 +72,7 @@ def test_ppo_trains_only_on_valid_slots_and_survives_save_and_load(
 ) -> None:
     model, env = _model(algorithm, policy, "linear")
     before = model.policy.mlp_extractor.actor.weight.detach().clone()
-    model.learn(64)
+    silent(model).learn(64)
     buffer = model.rollout_buffer
     masks = buffer.observations["action_mask"].reshape(-1, 6)
     taken = buffer.actions.reshape(-1).astype(int)
@@ -218,14 +222,14 @@ def test_train_explorer_ppo_resume_and_benchmark(tmp_path: Path) -> None:
     assert [row["success"] for row in rows if row["policy"] == "ppo"] == [1]  # the folder name
 
 
-def test_the_shipped_explorer_ppo_loads_and_explores(tmp_path: Path) -> None:
-    loaded = load_model("explorer-ppo")
+def test_the_explorer_ppo_research_model_loads_and_explores(tmp_path: Path) -> None:
+    loaded = load_model(EXPLORER_PPO)
     assert isinstance(loaded.model, MaskablePPO)
     assert type(loaded.model.policy) is MaskableSlotActorCriticPolicy
     assert loaded.metadata["experiment"]["train"]["algorithm"] == "maskable-ppo"
     out = tmp_path / "bench.json"
     code = main(
-        ["benchmark", "--policies", "explorer-ppo", "--families", "rooms-32", "--episodes", "2",
+        ["benchmark", "--policies", str(EXPLORER_PPO), "--families", "rooms-32", "--episodes", "2",
          "--split", "validation", "--json", str(out), "--no-progress"]
     )  # fmt: skip
     assert code == 0
@@ -233,7 +237,7 @@ def test_the_shipped_explorer_ppo_loads_and_explores(tmp_path: Path) -> None:
     assert row["policy"] == "explorer-ppo" and row["success"] == row["episodes"] == 2
 
 
-@pytest.mark.parametrize("name", ["explorer", "explorer-ppo"])
+@pytest.mark.parametrize("name", ["explorer", str(EXPLORER_PPO)])
 def test_skipping_forced_steps_leaves_the_slot_scorers_episodes_unchanged(name: str) -> None:
     """A slot scorer is not asked when one slot is valid; it would have taken that slot."""
     from frontier_marl.envs.parallel import FrontierParallelEnv

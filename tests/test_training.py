@@ -27,6 +27,7 @@ from frontier_marl.training.vec_env import (  # noqa: E402
     make_vec_env,
     parallel_envs,
 )
+from tests.helpers import silent  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 SMALL = {"height": 10, "width": 10, "perception_range": 2}
@@ -127,7 +128,7 @@ def _collect(env_kwargs: dict, steps: int, bootstrap_truncations: bool = True) -
 
     vec = make_vec_env(env_kwargs, seed=0, bootstrap_truncations=bootstrap_truncations)
     model = DQN("MultiInputPolicy", vec, learning_starts=10**9, buffer_size=1000, device="cpu")
-    model.learn(steps)
+    silent(model).learn(steps)
     return model
 
 

@@ -20,6 +20,7 @@ from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.worlds import WorldParams, Worlds
 from frontier_marl.envs.registration import GYM_ID
+from tests.helpers import silent
 
 STEP_KEYS = ("explored_fraction", "coverage", "new_cells", "travelled", "step", "end_reason")
 FULL_KEYS = ("padding", "oscillation")
@@ -212,7 +213,7 @@ def test_sb3_adapter_gives_supersuit_transitions_and_the_same_dqn() -> None:
             target_update_interval=100,
         )
         model.action_space.seed(3)
-        model.learn(600)
+        silent(model).learn(600)
         weights.append(torch.cat([p.flatten() for p in model.policy.parameters()]))
     assert torch.equal(weights[0], weights[1])
 

@@ -2,11 +2,12 @@
 
     frontier-marl evaluate thesis-config01
 
-Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN, or
-sb3-contrib MaskablePPO for ``explorer-ppo``) with its
-``model.json`` metadata (env config, observation layout, training run). How each was trained is
-in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``,
-``explorer-dqn``, ``explorer-ppo``, ``team-explorer``).
+Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with
+its ``model.json`` metadata (env config, observation layout, training run). How each was
+trained is in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md
+(``explorer``, ``team-explorer``). The research models of the explorer studies
+(``explorer-dqn``, ``explorer-ppo``) are not in the package: they lie in the repository's
+``training/models/`` and load by path.
 """
 
 from __future__ import annotations
@@ -35,15 +36,6 @@ PRETRAINED: dict[str, str] = {
     "unknown_near and fill features, trained by the cross-entropy method on T99 on five "
     "benchmark map families by `frontier-marl train explorer` (seed 0); the best-validated "
     "weights (generation 0 of 12)",
-    "explorer-dqn": "the first learned frontier selector (docs/beyond-the-thesis.md): DQN on a "
-    "masked, permutation-equivariant slot scorer on size-independent slot features, trained on "
-    "the four benchmark map families by `frontier-marl train explorer-dqn` (seed 0); the "
-    "best-validated policy (step 200,000); at parity with nearest-path",
-    "explorer-ppo": "a policy-gradient frontier selector (docs/beyond-the-thesis.md): "
-    "MaskablePPO on the masked, permutation-equivariant slot scorer (MLP actor, pooled "
-    "critic) with the explorer's features and a pure travel cost, trained on five benchmark "
-    "map families by `frontier-marl train explorer-ppo` (seed 0); the best-validated policy "
-    "(step 250,000 of 600,000)",
     "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
     "slot scorer with three teammate features per slot, one parameter-shared model for teams "
     "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
@@ -81,6 +73,14 @@ LEGACY_MODULES: dict[str, str] = {
     "frontier_marl.training.slot_policy": "frontier_marl.policies.networks.slot_dqn",
     "frontier_marl.training.slot_actor_critic": "frontier_marl.policies.networks.slot_actor_critic",
 }
+
+
+class MissingExtraError(ValueError):
+    """Loading a model needs an optional extra that is not installed."""
+
+
+#: The extra that provides each loader's module.
+EXTRAS: dict[str, str] = {"stable_baselines3": "train", "sb3_contrib": "train"}
 
 
 @dataclass
@@ -126,7 +126,14 @@ def loader(label: str | None) -> Any:
             f"the model's metadata names algorithm {label!r}; known: {sorted(LOADERS)}"
         )
     module, name = LOADERS[label or "DQN"]
-    return getattr(import_module(module), name)
+    try:
+        return getattr(import_module(module), name)
+    except ModuleNotFoundError as exc:
+        extra = EXTRAS.get(module, "train")
+        raise MissingExtraError(
+            f"a {label or 'DQN'} model needs the {extra!r} extra ({exc.name} is not installed): "
+            f"pip install 'frontier-marl[{extra}]'"
+        ) from exc
 
 
 @contextmanager
@@ -143,10 +150,14 @@ def legacy_module_names() -> Iterator[None]:
 
 
 def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
-    """Load an SB3 model (DQN, PPO or MaskablePPO, by its metadata) and its metadata."""
+    """Load an SB3 model (DQN, PPO or MaskablePPO, by its metadata) and its metadata;
+    :class:`MissingExtraError` naming the extra to install if SB3 is missing."""
     model_path = resolve_model_path(path)
     metadata = load_metadata(model_path)
-    algorithm = loader(None if metadata is None else metadata.get("algorithm"))
+    try:
+        algorithm = loader(None if metadata is None else metadata.get("algorithm"))
+    except MissingExtraError as exc:
+        raise MissingExtraError(f"model {str(path)!r}: {exc}") from None
     with legacy_module_names():
         model = algorithm.load(model_path, device=device)
     return LoadedModel(model=model, path=model_path, metadata=metadata)

@@ -11,7 +11,7 @@ import numpy as np
 
 
 class HumanViewer:
-    """Shows frames in a matplotlib window (imported lazily); closes cleanly."""
+    """Shows frames in a matplotlib window of its own (imported lazily); closes cleanly."""
 
     def __init__(self, fps: float = 4.0, title: str = "frontier_marl") -> None:
         self.fps = fps
@@ -27,7 +27,9 @@ class HumanViewer:
         frame = np.asarray(frame)
         if self._fig is None or not plt.fignum_exists(self._fig.number):
             plt.ion()
-            self._fig, self._ax = plt.subplots(num=self.title)
+            self._fig, self._ax = plt.subplots()  # a figure of its own: viewers never share
+            if self._fig.canvas.manager is not None:
+                self._fig.canvas.manager.set_window_title(self.title)
             self._ax.set_axis_off()
             self._fig.tight_layout(pad=0.1)
             self._im = self._ax.imshow(frame, interpolation="nearest")
