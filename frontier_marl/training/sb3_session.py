@@ -171,58 +171,76 @@ def train_sb3(
     def checkpoint_now(m: Any) -> Checkpoint:
         return save_checkpoint(m, run_dir, metadata(), keep=settings.keep_checkpoints)
 
-    progress = ProgressBar() if progress_bar else None
-    all_callbacks = [
-        *callbacks,
-        *([progress] if progress is not None else []),
-        *session_callbacks(experiment, run_dir, metadata, checkpoint_now, start_step),
-    ]
-    remaining = settings.total_timesteps - model.num_timesteps
-    interrupted = False
+    periodic = session_callbacks(experiment, run_dir, metadata, checkpoint_now, start_step)
     started, cpu_started = time.perf_counter(), time.process_time()
-    try:
-        if remaining > 0:
-            model.learn(
-                remaining,
-                callback=all_callbacks,
-                log_interval=settings.log_interval,
-                reset_num_timesteps=checkpoint is None,
-            )
-    except KeyboardInterrupt:
-        interrupted = True
-        if progress is not None:
-            progress.close()
+    interrupted = learn(model, experiment, checkpoint is None, callbacks, periodic, progress_bar)
     wall = time.perf_counter() - started
     cpu = time.process_time() - cpu_started
-    steps_done = model.num_timesteps - start_step
 
-    last = checkpoint_now(model)
-    model_path = run_dir / MODEL_FILE
-    model.save(model_path)
-    meta = metadata()
-    meta["training"] = {"wall_time_s": wall, "cpu_time_s": cpu, "steps_this_session": steps_done}
-    save_metadata(meta, run_dir / "model.json")
+    result = TrainResult(
+        run_dir=run_dir,
+        model_path=run_dir / MODEL_FILE,
+        num_timesteps=model.num_timesteps,
+        steps_this_session=model.num_timesteps - start_step,
+        wall_time_s=wall,
+        cpu_time_s=cpu,
+        interrupted=interrupted,
+    )
+    result.files["checkpoint"] = checkpoint_now(model).path
+    meta = save_model(model, metadata(), result)
     resumed_from = None if checkpoint is None else checkpoint.path
     record_session(
         run_dir, experiment, start_step, model.num_timesteps, wall, cpu, interrupted, resumed_from
     )
     model.logger.close()
     vec_env.close()
-
-    result = TrainResult(
-        run_dir=run_dir,
-        model_path=model_path,
-        num_timesteps=model.num_timesteps,
-        steps_this_session=steps_done,
-        wall_time_s=wall,
-        cpu_time_s=cpu,
-        interrupted=interrupted,
-        files={"checkpoint": last.path, "model": model_path, "metadata": run_dir / "model.json"},
-    )
     result.files["learning_curve"] = plot_learning_curve(run_dir, experiment, result.num_timesteps)
     if not interrupted and settings.eval_episodes > 0:
-        evaluate_session(LoadedModel(model, model_path, meta), cfg, experiment, run_dir, result)
+        loaded = LoadedModel(model, result.model_path, meta)
+        evaluate_session(loaded, cfg, experiment, run_dir, result)
     return result
+
+
+def learn(
+    model: Any,
+    experiment: Experiment,
+    fresh: bool,
+    callbacks: Sequence[Any],
+    periodic: Sequence[Any],
+    progress_bar: bool,
+) -> bool:
+    """Run ``model.learn`` to ``train.total_timesteps`` with the user's callbacks, the progress
+    bar and the periodic ones, in that order; True if it was interrupted."""
+    settings = experiment.train
+    progress = [ProgressBar()] if progress_bar else []
+    remaining = settings.total_timesteps - model.num_timesteps
+    try:
+        if remaining > 0:
+            model.learn(
+                remaining,
+                callback=[*callbacks, *progress, *periodic],
+                log_interval=settings.log_interval,
+                reset_num_timesteps=fresh,
+            )
+    except KeyboardInterrupt:
+        for bar in progress:
+            bar.close()
+        return True
+    return False
+
+
+def save_model(model: Any, meta: dict[str, Any], result: TrainResult) -> dict[str, Any]:
+    """Save the final ``RUN/model.zip`` and its ``model.json`` (with the session's times)."""
+    model.save(result.model_path)
+    meta["training"] = {
+        "wall_time_s": result.wall_time_s,
+        "cpu_time_s": result.cpu_time_s,
+        "steps_this_session": result.steps_this_session,
+    }
+    save_metadata(meta, result.model_path.with_name("model.json"))
+    result.files["model"] = result.model_path
+    result.files["metadata"] = result.model_path.with_name("model.json")
+    return meta
 
 
 def evaluate_session(
