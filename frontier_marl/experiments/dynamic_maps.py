@@ -82,7 +82,3 @@ def main(argv: list[str] | None = None) -> int:
         report = {"commit": args.commit, "static": {f"{p} {h}": v for (p, h), v in static.items()}}
         args.json.write_text(json.dumps({**report, "rows": rows}, indent=1) + "\n")
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

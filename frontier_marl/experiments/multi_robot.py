@@ -19,7 +19,7 @@ per-episode records; the coverage curves only with ``--curves``), ``comparison.j
 paired comparison with greedy distance), ``summary.md`` (the tables of docs/multi-robot.md) and
 one PNG per map (:func:`frontier_marl.evaluation.plots.plot_team_comparison`).
 
-The shared-parameter DQN (``training/team_30x30.toml``, ``training/team_rooms64.toml``) is
+The shared-parameter DQN (``frontier-marl train team_30x30``, ``team_rooms64``) is
 evaluated with ``--dqn-30x30 RUN_DIR --dqn-rooms64 RUN_DIR`` (either or both): each model on its
 own map with 1, 2 and 4 robots (policy ``dqn-shared``, deterministic), beside greedy distance and
 coordinated assignment re-run on the same episodes, into ``dqn.json`` and ``dqn.md`` (the other
@@ -45,13 +45,17 @@ from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import make_config
 from frontier_marl.core.example_maps import example_map_path
 from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.plots import plot_team_comparison, team_value
 from frontier_marl.experiments.baselines import dumps_rows
-from frontier_marl.policies import Policy, make_policy
+from frontier_marl.policies import ModelPolicy, Policy, make_policy
+from frontier_marl.policies.models import check_model_env, load_model
 
-OUT = Path(__file__).resolve().parent / "results" / "multi_robot"
+#: The default output folder, relative to the working directory (the repository root);
+#: ``baselines/multi_robot.py`` passes its own ``results/multi_robot``.
+OUT = Path("baselines") / "results" / "multi_robot"
 HEURISTICS = ("greedy-distance", "coordinated-assignment", "utility-discount")
 BASELINE = "greedy-distance"
 
@@ -109,10 +113,6 @@ DQN_COMPARED = ("greedy-distance", "coordinated-assignment")
 def dqn_factory(run: Path, setting_kwargs: Mapping[str, Any], robots: Sequence[int]):
     """A zero-argument factory of the deterministic ``dqn-shared`` policy of run folder ``run``,
     after checking that the model fits the setting's env with every team size."""
-    from frontier_marl.config import make_config
-    from frontier_marl.policies import ModelPolicy
-    from frontier_marl.policies.models import check_model_env, load_model
-
     loaded = load_model(run)
     for n in robots:
         check_model_env(loaded, make_config(**{**setting_kwargs, "n_agents": n}))
@@ -323,12 +323,13 @@ def without_curves(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     ]
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, default_out: Path = OUT) -> int:
+    """The command line of ``baselines/multi_robot.py`` (``default_out``: ``--out``'s default)."""
     parser = argparse.ArgumentParser(description="multi-robot coordination experiment")
     parser.add_argument("--episodes", type=int, default=30, help="per row (default: 30)")
     parser.add_argument("--seed", type=int, default=0, help="first reset seed (default: 0)")
     parser.add_argument("--robots", default="1,2,4", help="team sizes (default: 1,2,4)")
-    parser.add_argument("--out", type=Path, default=OUT, help="output folder")
+    parser.add_argument("--out", type=Path, default=default_out, help="output folder")
     parser.add_argument(
         "--curves",
         action="store_true",
@@ -377,8 +378,6 @@ def main(argv: list[str] | None = None) -> int:
         "python baselines/multi_robot.py"
         + (f" {' '.join(argv)}" if argv else " " + " ".join(sys.argv[1:])).rstrip()
     )
-    from frontier_marl.config import make_config
-
     shown = (
         "perception_range",
         "sensor",
@@ -424,7 +423,3 @@ def main(argv: list[str] | None = None) -> int:
         f"{', '.join(f'{s}.png' for s in env_settings)}"
     )
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -125,6 +125,9 @@ QUICK_REFINE: dict[str, Any] = {
     "max_cluster_cells": [6, 8],
 }
 
+#: The default folder of ``--out``, relative to the working directory (the repository root).
+RESULTS = Path("baselines") / "results"
+
 STD_WEIGHT = 0.25
 ORDER_PENALTY = 10.0
 SLOTS_PENALTY = 1.0
@@ -302,7 +305,9 @@ def _setting_text(setting: dict[str, Any]) -> str:
     return " ".join(f"{k}={v}" for k, v in setting.items())
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
+    """The command line of ``baselines/calibrate.py``, which passes its own ``results/`` folder
+    as ``results_dir`` (where ``--out`` goes by default)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0, help="episode i uses reset seed seed+i")
@@ -328,7 +333,7 @@ def main(argv: list[str] | None = None) -> int:
         args.top, args.passes, args.validate = 1, 1, 2
     if args.out is None:
         name = "calibration-quick.json" if args.quick else "calibration.json"
-        args.out = Path(__file__).parent / "results" / name
+        args.out = results_dir / name
     coarse = QUICK_COARSE if args.quick else COARSE
     refine = QUICK_REFINE if args.quick else REFINE
 
@@ -462,7 +467,3 @@ def main(argv: list[str] | None = None) -> int:
     args.out.write_text(json.dumps(out, indent=1))
     log(f"\nwrote {args.out} ({ev.cpu_seconds:.0f} s CPU, {wall_s:.0f} s wall)")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -22,9 +22,11 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.cli.arguments import parse_set_options
+from frontier_marl.core.example_maps import resolve_map
+from frontier_marl.envs import FrontierParallelEnv
 from frontier_marl.policies import make_policy
 from frontier_marl.utils.progress import progress_bar
+from frontier_marl.utils.set_options import parse_set_options
 
 STUCK = ("no_progress", "step_limit")
 
@@ -33,9 +35,7 @@ def stuck_episode(
     env_kwargs: dict[str, Any], policy_name: str, options: dict[str, Any], seed: int
 ) -> dict[str, Any] | None:
     """The record of episode ``seed`` if it ends stuck, else ``None``."""
-    import frontier_marl
-
-    env = frontier_marl.parallel_env(**env_kwargs)
+    env = FrontierParallelEnv(**env_kwargs)
     policy = make_policy(policy_name, seed, **options)
     policy.attach(env)
     policy.reset(seed)
@@ -111,8 +111,6 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     env_kwargs: dict[str, Any] = {"preset": args.preset, "map_mode": args.map_mode}
     if args.map is not None:
-        from frontier_marl.core.example_maps import resolve_map
-
         env_kwargs = {"preset": args.preset, "map_path": resolve_map(args.map)}
     env_kwargs.update(parse_set_options(args.overrides))
     options = parse_set_options(args.option)
@@ -145,7 +143,3 @@ def main(argv: list[str] | None = None) -> int:
         args.json.write_text(json.dumps(report, indent=1) + "\n")
         print(f"wrote {args.json}", file=sys.stderr)
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

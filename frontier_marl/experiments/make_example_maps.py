@@ -20,13 +20,18 @@ from frontier_marl.core.example_maps import EXAMPLE_MAPS, generate_example_map
 from frontier_marl.core.map_files import format_text_map
 from frontier_marl.core.maps import FOUR_CONNECTED
 
-OUT = Path(__file__).resolve().parents[1] / "frontier_marl" / "assets" / "maps"
+#: The package's example maps (``baselines/make_example_maps.py`` passes the checkout's).
+OUT = Path(__file__).resolve().parents[1] / "assets" / "maps"
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, default_out: Path = OUT) -> int:
+    """The command line of ``baselines/make_example_maps.py`` (``default_out``: ``--out``'s
+    default)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
-    parser.add_argument("--out", type=Path, default=OUT, help="folder (default: %(default)s)")
+    parser.add_argument(
+        "--out", type=Path, default=default_out, help="folder (default: %(default)s)"
+    )
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     stale = []
@@ -47,7 +52,3 @@ def main(argv: list[str] | None = None) -> int:
     for path in stale:
         print(f"stale: {path}", file=sys.stderr)
     return 1 if stale else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
