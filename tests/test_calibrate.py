@@ -7,7 +7,8 @@ import json
 
 import pytest
 
-from frontier_marl.experiments.calibrate import fits, main, score_of
+from frontier_marl.experiments.calibrate import main
+from frontier_marl.experiments.calibration_search import fits, score_of
 
 
 def row(gd: tuple[float, float], gg: tuple[float, float], n_slots: int = 4) -> dict:

@@ -23,7 +23,7 @@ from frontier_marl.core.example_maps import example_map_path
 from frontier_marl.core.grid import FREE, OCCUPIED
 from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.metrics import makespan_curve, overlap_ratio
-from frontier_marl.experiments import multi_robot
+from frontier_marl.experiments import multi_robot, multi_robot_tables
 from frontier_marl.policies import (
     TEAM_POLICIES,
     CoordinatedAssignment,
@@ -687,13 +687,13 @@ def test_multi_robot_experiment_script_runs(tmp_path):
         (2, "greedy-distance"),
         (2, "coordinated-assignment"),
     ]
-    table = multi_robot.results_table(rows)
+    table = multi_robot_tables.results_table(rows)
     assert table.count("\n") == 5 and "| tiny | 2 | coordinated-assignment |" in table
-    entries = multi_robot.comparison(rows)
+    entries = multi_robot_tables.comparison(rows)
     assert len(entries) == 1 and entries[0]["n_agents"] == 2
     overlap = entries[0]["overlap"]
     assert overlap["wins"] + overlap["ties"] + overlap["losses"] == 2
-    assert "coordinated-assignment" in multi_robot.comparison_table(entries)
+    assert "coordinated-assignment" in multi_robot_tables.comparison_table(entries)
     from frontier_marl.evaluation.plots import plot_team_comparison
 
     plot_team_comparison(rows, tmp_path / "tiny.png", title="tiny")
