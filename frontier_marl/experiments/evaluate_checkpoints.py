@@ -14,19 +14,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
+
+from frontier_marl.evaluation.model_evaluation import evaluate_model
+from frontier_marl.policies.model_files import list_checkpoints
+from frontier_marl.policies.models import load_model
 
 
 def evaluate_checkpoints(
     run_dir: str | Path, seeds: list[int], episodes: int = 30
 ) -> list[dict[str, Any]]:
     """One row per checkpoint: its step and, per seed, mean reward and terminations."""
-    from frontier_marl.evaluation.model_evaluation import evaluate_model
-    from frontier_marl.policies.model_files import list_checkpoints
-    from frontier_marl.policies.models import load_model
-
     checkpoints = list_checkpoints(run_dir)
     if not checkpoints:
         raise ValueError(f"no checkpoints in {str(run_dir)!r}")
@@ -61,7 +60,3 @@ def main(argv: list[str] | None = None) -> int:
     if args.json is not None:
         args.json.write_text(json.dumps(rows, indent=1) + "\n")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -125,7 +125,3 @@ def main(argv: list[str] | None = None) -> int:
         path = write_json(summary, args.out / f"{run_dir.name}.json")
         print(f"wrote {path} ({path.stat().st_size / 1024:.0f} kB)")
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

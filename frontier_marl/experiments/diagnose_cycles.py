@@ -55,15 +55,12 @@ def diagnose(model_dir: Path, episodes: int) -> dict[str, float]:
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("model", help="a shipped model name or a run folder with model.zip")
     parser.add_argument("--episodes", type=int, default=30)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     folder = pretrained_model_dir(args.model) if args.model in PRETRAINED else Path(args.model)
     for key, value in diagnose(folder, args.episodes).items():
         print(f"{key:<45}{value:g}")
-
-
-if __name__ == "__main__":
-    main()
+    return 0
