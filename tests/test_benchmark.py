@@ -341,10 +341,8 @@ def test_cli_shipped_model_keeps_its_observation_settings(tmp_path, capsys):
 def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
     tmp_path: Path,
 ) -> None:
-    import runpy
+    from frontier_marl.experiments.explorer_studies.resolution_sweep import main as sweep
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "resolution_sweep.py"
-    sweep = runpy.run_path(str(script))["main"]
     out = tmp_path / "sweep.json"
     argv = ["--scales", "1,2", "--episodes", "1", "--policies", "cost-utility,nearest-path"]
     assert sweep([*argv, "--json", str(out)]) == 0

@@ -25,7 +25,7 @@ own map with 1, 2 and 4 robots (policy ``dqn-shared``, deterministic), beside gr
 coordinated assignment re-run on the same episodes, into ``dqn.json`` and ``dqn.md`` (the other
 outputs are not touched)::
 
-    python baselines/multi_robot.py --episodes 50 \
+    python baselines/multi_robot.py --episodes 50 \\
         --dqn-30x30 runs/team_30x30 --dqn-rooms64 runs/team_rooms64
 
 Other policies plug in through

@@ -103,7 +103,3 @@ def main(argv: list[str] | None = None) -> int:
     if args.json is not None:
         args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

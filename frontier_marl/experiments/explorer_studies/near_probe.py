@@ -100,7 +100,3 @@ def main(argv: list[str] | None = None) -> int:
         payload = {"what": "mean T99 relative to the path-only scorer", "options": options}
         args.json.write_text(json.dumps({**payload, "rows": rows, "mean": means}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

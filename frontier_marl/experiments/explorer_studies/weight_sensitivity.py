@@ -101,7 +101,3 @@ def main(argv: list[str] | None = None) -> int:
         what = "mean paired per-episode T99 change against the explorer's shipped weights"
         args.json.write_text(json.dumps({"what": what, "options": options, "rows": rows}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -51,7 +51,3 @@ def main(argv: list[str] | None = None) -> int:
         options = {"weights": weights, "episodes": args.episodes, "first_seed": args.first}
         args.json.write_text(json.dumps({"options": options, "rows": summary}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -58,7 +58,3 @@ def main(argv: list[str] | None = None) -> int:
         command = {"episodes": args.episodes, "first_seed": args.first, "models": names}
         args.json.write_text(json.dumps({"options": command, "rows": summary}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -96,7 +96,3 @@ def main(argv: list[str] | None = None) -> int:
         }
         args.json.write_text(json.dumps({"options": options, "rows": summary}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -117,7 +117,3 @@ def main(argv: list[str] | None = None) -> int:
         payload = {"what": what, "options": {**options, "first_seed": args.first}, "rows": rows}
         args.json.write_text(json.dumps(payload, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -63,13 +63,13 @@ def nearest_path_choices(data: Dataset) -> np.ndarray:
     return key.argmin(axis=1)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=4)
     parser.add_argument("--epochs", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", default=None, help="write the records here")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     th.set_num_threads(1)
     th.manual_seed(args.seed)
     experiment = load_experiment("explorer-dqn")
@@ -130,7 +130,4 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as handle:
             json.dump({"episodes_per_round": EPISODES, "records": records}, handle, indent=1)
-
-
-if __name__ == "__main__":
-    main()
+    return 0

@@ -17,7 +17,7 @@ ones), with ``frontier-marl benchmark``:
   ``frontier-marl train explorer --set env.tour=false --out runs/no-tour``, then
   ``cp -r runs/no-tour/best runs/explorer-no-tour``: a model is labelled by its folder).
 
-    python benchmarks/explorer_ablation.py --episodes 64 \
+    python benchmarks/explorer_ablation.py --episodes 64 \\
         --json training/results/explorer/ablation.json
 """
 
@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from frontier_marl.cli.main import main as cli
 from frontier_marl.training.cem import save_hand_set
 from frontier_marl.training.experiment import load_experiment
 
@@ -46,7 +45,11 @@ def save_rules(out: Path) -> list[str]:
     return [str(out / label) for label in HAND_SET]
 
 
-def main(argv: list[str] | None = None) -> int:
+def benchmark_command(argv: list[str] | None = None) -> list[str]:
+    """The command line of ``benchmarks/explorer_ablation.py``: saves the hand-set rules under
+    ``--out`` and returns the ``frontier-marl benchmark`` arguments that score them beside the
+    other policies (the script runs them with :func:`frontier_marl.cli.main.main`; the CLI is
+    the layer above this one)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=64, help="validation episodes per family")
     parser.add_argument("--models", default="", help="comma-separated extra model folders")
@@ -62,8 +65,4 @@ def main(argv: list[str] | None = None) -> int:
         command += ["--json", str(args.json)]
     if args.no_progress:
         command.append("--no-progress")
-    return cli(command)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    return command
