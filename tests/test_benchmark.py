@@ -363,15 +363,13 @@ def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
 
 
 def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
-    import runpy
+    from frontier_marl.experiments.speed import bench_explorer_features as bench
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_explorer_features.py"
-    bench = runpy.run_path(str(script))
     out = tmp_path / "cost.json"
     argv = ["--families", "random-20", "--worlds", "2", "--seconds", "0.05", "--json", str(out)]
-    assert bench["main"](argv) == 0
+    assert bench.main(argv) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert [row["layout"] for row in rows] == list(bench["LAYOUTS"])
+    assert [row["layout"] for row in rows] == list(bench.LAYOUTS)
     assert all(row["decisions_per_s"] > 0 for row in rows)
     with pytest.raises(SystemExit):
-        bench["main"](["--worlds", "0"])
+        bench.main(["--worlds", "0"])

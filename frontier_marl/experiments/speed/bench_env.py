@@ -10,6 +10,10 @@ DQN training wall time spent in the env: the same DQN trains for the same number
 env and on a null env with identical spaces, in one run (interleaved in chunks), and
 
     env share = (T_env - T_null) / T_env.
+
+``benchmarks/bench_revisions.py`` loads this module from its file to time older source trees of
+the package with it, so it reads the package only through its public names (``frontier_marl``).
+SB3 and torch (the train extra) are imported by the DQN part alone, where it runs.
 """
 
 from __future__ import annotations
@@ -47,16 +51,13 @@ SETTINGS: list[tuple[str, dict[str, Any]]] = [
 ]
 
 
-SHARED_MAPS = Path(__file__).resolve().parents[2] / "shared/maps/explore-bench"
-EXPLORE_BENCH_MAP = SHARED_MAPS / "room1_modified.pgm"
-
-
 def explore_bench_settings(map_file: Path) -> list[tuple[str, dict[str, Any]]]:
     """Explore-Bench's room1_modified map with its classical sensor range (35 cells).
 
     Explore-Bench's own Python simulator reached ~12 steps/s (nearest frontier, one cell per
     step) and ~2.7 steps/s (learning env, one goal per step, moved all the way) on this map and
-    machine kind (figures from shared/maps/explore-bench/README.md).
+    machine kind (figures from shared/maps/explore-bench/README.md, the folder beside the
+    repository, where ``benchmarks/bench_env.py`` looks for the map).
     """
     common = {
         "map_path": str(map_file),
@@ -198,7 +199,10 @@ def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, Any]:
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None, *, explore_bench_map: Path | None = None) -> int:
+    """The command line of ``benchmarks/bench_env.py``, which passes Explore-Bench's
+    room1_modified map beside the repository as ``explore_bench_map`` (the default of
+    ``--explore-bench-map``)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=8.0, help="timed seconds per setting")
     parser.add_argument("--dqn-steps", type=int, default=30_000)
@@ -210,12 +214,12 @@ def main() -> None:
     parser.add_argument(
         "--explore-bench-map",
         type=Path,
-        default=EXPLORE_BENCH_MAP,
+        default=explore_bench_map,
         help="Explore-Bench PGM map for the side-by-side figure (skipped if absent)",
     )
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     settings = list(SETTINGS)
-    if args.explore_bench_map.is_file():
+    if args.explore_bench_map is not None and args.explore_bench_map.is_file():
         settings += explore_bench_settings(args.explore_bench_map)
     report: dict[str, Any] = {
         "machine": platform.processor() or platform.machine(),
@@ -243,7 +247,4 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as handle:
             json.dump(report, handle, indent=2)
-
-
-if __name__ == "__main__":
-    main()
+    return 0

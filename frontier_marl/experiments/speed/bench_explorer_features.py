@@ -14,15 +14,13 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import runpy
 from pathlib import Path
 from typing import Any
 
 import frontier_marl
 from frontier_marl.config import config_to_dict
 from frontier_marl.evaluation.benchmark.families import family, variant_configs
-
-_BENCH_VECTOR_ENV = runpy.run_path(str(Path(__file__).with_name("bench_vector_env.py")))
+from frontier_marl.experiments.speed.bench_vector_env import rate_batched
 
 #: The observation layouts compared, each the previous one plus one feature.
 LAYOUTS: dict[str, dict[str, Any]] = {
@@ -36,8 +34,8 @@ LAYOUTS: dict[str, dict[str, Any]] = {
 
 def decisions_per_second(kwargs: dict[str, Any], worlds: int, seconds: float) -> float:
     """Random valid decisions per second of ``worlds`` batched worlds built from ``kwargs``
-    (``bench_vector_env.py``'s measurement)."""
-    return float(_BENCH_VECTOR_ENV["rate_batched"](kwargs, worlds, seconds))
+    (:func:`~frontier_marl.experiments.speed.bench_vector_env.rate_batched`)."""
+    return float(rate_batched(kwargs, worlds, seconds))
 
 
 def warm_up(kwargs: dict[str, Any]) -> None:
@@ -78,7 +76,3 @@ def main(argv: list[str] | None = None) -> int:
         options = {"worlds": args.worlds, "seconds": args.seconds, "machine": machine}
         args.json.write_text(json.dumps({"options": options, "rows": rows}, indent=1))
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -14,6 +14,9 @@
    observation) on the batched env with 8 worlds, and PPO on 16, each against a null vector env
    with identical spaces, the two trainings interleaved in chunks (env share =
    (T_env - T_null) / T_env).
+
+SB3, SuperSuit and torch (the train extra) are imported where they are used: the batched
+env's rates (:func:`rate_batched`, which ``bench_explorer_features`` uses) need none of them.
 """
 
 from __future__ import annotations
@@ -24,9 +27,11 @@ import platform
 import time
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 import frontier_marl
+from frontier_marl.config import make_config
 
 SETTINGS: dict[str, dict[str, Any]] = {
     "thesis-20x20, 1 robot": {"preset": "thesis-20x20"},
@@ -101,7 +106,6 @@ def rate_sb3(make_vec: Any, n: int, seconds: float) -> float:
 
 
 def dummy_vec_env(kwargs: dict[str, Any]) -> Any:
-    import gymnasium as gym
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     def make(n: int) -> Any:
@@ -236,7 +240,6 @@ def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict
     import torch
     from stable_baselines3 import DQN, PPO
 
-    from frontier_marl.config import make_config
     from frontier_marl.training.batched_vec_env import make_batched_vec_env
 
     torch.set_num_threads(1)
@@ -275,7 +278,7 @@ def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=3.0, help="timed seconds per figure")
     parser.add_argument("--dqn-steps", type=int, default=100_000)
@@ -284,7 +287,7 @@ def main() -> None:
     parser.add_argument("--skip-training", action="store_true")
     parser.add_argument("--skip-decisions", action="store_true")
     parser.add_argument("--json", help="write the figures to this file")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     report: dict[str, Any] = {
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
@@ -305,7 +308,4 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as handle:
             json.dump(report, handle, indent=2)
-
-
-if __name__ == "__main__":
-    main()
+    return 0

@@ -22,8 +22,15 @@ import tempfile
 import time
 from pathlib import Path
 
+import stable_baselines3
 from scipy import ndimage
+from stable_baselines3 import DQN
 
+from frontier_marl.core import world
+from frontier_marl.envs import parallel
+from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.sim import engine
+from frontier_marl.training import vec_env as vec_module
 from frontier_marl.training.experiment import load_experiment
 from frontier_marl.training.train import train
 
@@ -53,10 +60,6 @@ class Timer:
 
 def stage_functions() -> list[tuple[object, str]]:
     """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
-    from frontier_marl.core import world
-    from frontier_marl.envs import parallel
-    from frontier_marl.sim import engine
-
     return [
         (world.World, "move"),  # planning, walking, sensing
         (engine.ExplorationMDP, "_refresh_slots"),  # clusters (with ndimage.label) and slots
@@ -77,13 +80,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--stages", action="store_true", help="time the stages of a step too")
     args = parser.parse_args(argv)
-
-    import stable_baselines3
-    from stable_baselines3 import DQN
-
-    from frontier_marl.envs.parallel import FrontierParallelEnv
-    from frontier_marl.training import vec_env as vec_module
-
     experiment = load_experiment(
         args.config,
         [
@@ -163,7 +159,3 @@ def main(argv: list[str] | None = None) -> int:
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2) + "\n")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
