@@ -13,7 +13,7 @@ thesis-20x20 with one robot and random valid actions:
   (``info="minimal"`` where the tree has it);
 * ``env_share``: the share of thesis-DQN training time spent in the env (training infos),
   against a null env with the same spaces, interleaved in chunks within one process
-  (``bench_env.train_interleaved``).
+  (:func:`frontier_marl.experiments.speed.bench_env.train_interleaved`).
 
 The report gives each figure's median and minimum over the rounds per tree and the ratio of
 the medians (``--dqn-steps 0`` leaves the training share out, for quick step timings).
@@ -22,6 +22,7 @@ the medians (``--dqn-steps 0`` leaves the training share out, for quick step tim
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import statistics
@@ -29,9 +30,12 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
+#: The measurement code of the training share, in this checkout.
+BENCH_ENV = HERE.parent / "frontier_marl" / "experiments" / "speed" / "bench_env.py"
 
 
 def make_env(training: bool) -> Any:
@@ -69,12 +73,21 @@ def step_us(training: bool, steps: int) -> float:
     return 1e6 * elapsed / steps
 
 
-def env_share(steps: int, chunks: int) -> float:
-    sys.path.insert(0, str(HERE))
-    from bench_env import NullEnv, train_interleaved
+def checkout_module(path: Path) -> ModuleType:
+    """The module in ``path``, loaded from its file: the worker's ``frontier_marl`` is the tree
+    under test (``PYTHONPATH``), which may predate the module, and every tree is measured by
+    this checkout's code."""
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
+
+def env_share(steps: int, chunks: int) -> float:
+    bench = checkout_module(BENCH_ENV)
     env = make_env(training=True)
-    seconds = train_interleaved({"null": NullEnv(env), "env": env}, steps, chunks)
+    seconds = bench.train_interleaved({"null": bench.NullEnv(env), "env": env}, steps, chunks)
     null, real = sum(seconds["null"]), sum(seconds["env"])
     return (real - null) / real
 

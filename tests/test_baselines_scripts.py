@@ -1,33 +1,29 @@
-"""The diagnostic scripts of baselines/ with tiny budgets: they run and report consistently."""
+"""The diagnostics behind baselines/livelocks.py and dynamic_maps.py with tiny budgets: they run
+and report consistently."""
 
 from __future__ import annotations
 
 import json
-import runpy
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-
-
-def script(name: str):  # noqa: ANN201
-    return runpy.run_path(str(REPO / "baselines" / f"{name}.py"))["main"]
+from frontier_marl.experiments import dynamic_maps, livelocks
 
 
 def test_livelocks_finds_the_30x30_cycle_and_the_rule_removes_it(tmp_path: Path) -> None:
     out = tmp_path / "stuck.json"
     args = ["--preset", "thesis-30x30", "--episodes", "1", "--seed", "16", "--no-progress"]
-    assert script("livelocks")([*args, "--policies", "greedy-distance", "--json", str(out)]) == 0
+    assert livelocks.main([*args, "--policies", "greedy-distance", "--json", str(out)]) == 0
     (record,) = json.loads(out.read_text())["greedy-distance"]
     assert record["seed"] == 16 and record["end_reason"] == "no_progress"
     assert record["alternating"] and record["distinct_targets"] == 2
     fixed = ["--option", "commit=until-progress", "--policies", "greedy-distance"]
-    assert script("livelocks")([*args, *fixed, "--json", str(out)]) == 0
+    assert livelocks.main([*args, *fixed, "--json", str(out)]) == 0
     assert json.loads(out.read_text())["greedy-distance"] == []
 
 
 def test_dynamic_maps_reports_every_candidate(tmp_path: Path) -> None:
     out = tmp_path / "dynamic.json"
-    assert script("dynamic_maps")(["--episodes", "1", "--no-progress", "--json", str(out)]) == 0
+    assert dynamic_maps.main(["--episodes", "1", "--no-progress", "--json", str(out)]) == 0
     report = json.loads(out.read_text())
     assert len(report["rows"]) == 8 and len(report["static"]) == 4
     for row in report["rows"]:

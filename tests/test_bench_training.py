@@ -1,18 +1,16 @@
-"""The benchmark scripts with tiny budgets: their reports are consistent."""
+"""The speed benchmarks with tiny budgets: their reports are consistent."""
 
 from __future__ import annotations
 
 import json
-import runpy
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
+from frontier_marl.experiments.speed import bench_env, bench_labelling, bench_training
 
 
 def test_stage_report_is_consistent(tmp_path: Path) -> None:
-    main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
     out = tmp_path / "speed.json"
-    assert main(["config01", "--steps", "600", "--stages", "--json", str(out)]) == 0
+    assert bench_training.main(["config01", "--steps", "600", "--stages", "--json", str(out)]) == 0
     report = json.loads(out.read_text())
     assert report["steps"] == 600
     shares = [report[k] for k in report if k.startswith("share_")]
@@ -40,15 +38,13 @@ def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
     from frontier_marl.sim import engine
 
     before = (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset)
-    main = runpy.run_path(str(REPO / "benchmarks" / "bench_training.py"))["main"]
-    main(["config01", "--steps", "200", "--stages"])
+    bench_training.main(["config01", "--steps", "200", "--stages"])
     assert (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset) == before
 
 
 def test_labelling_benchmark_counts(tmp_path: Path) -> None:
-    main = runpy.run_path(str(REPO / "benchmarks" / "bench_labelling.py"))["main"]
     out = tmp_path / "labelling.json"
-    assert main(["--steps", "300", "--json", str(out)]) == 0
+    assert bench_labelling.main(["--steps", "300", "--json", str(out)]) == 0
     report = json.loads(out.read_text())
     rollout = report["rollout"]
     assert rollout["steps"] == 300
@@ -63,8 +59,7 @@ def test_labelling_benchmark_counts(tmp_path: Path) -> None:
 
 
 def test_env_share_interleaves_equal_runs() -> None:
-    module = runpy.run_path(str(REPO / "benchmarks" / "bench_env.py"))
-    report = module["dqn_env_share"](600, 3)
+    report = bench_env.dqn_env_share(600, 3)
     assert report["steps"] == 600 and report["chunks"] == 3
     assert report["seconds_null"] > 0 and report["seconds_env"] > 0
     expected = (report["seconds_env"] - report["seconds_null"]) / report["seconds_env"]

@@ -341,10 +341,8 @@ def test_cli_shipped_model_keeps_its_observation_settings(tmp_path, capsys):
 def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
     tmp_path: Path,
 ) -> None:
-    import runpy
+    from frontier_marl.experiments.explorer_studies.resolution_sweep import main as sweep
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "resolution_sweep.py"
-    sweep = runpy.run_path(str(script))["main"]
     out = tmp_path / "sweep.json"
     argv = ["--scales", "1,2", "--episodes", "1", "--policies", "cost-utility,nearest-path"]
     assert sweep([*argv, "--json", str(out)]) == 0
@@ -365,15 +363,13 @@ def test_the_resolution_sweep_draws_the_layouts_finer_with_the_sensor_scaled(
 
 
 def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
-    import runpy
+    from frontier_marl.experiments.speed import bench_explorer_features as bench
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_explorer_features.py"
-    bench = runpy.run_path(str(script))
     out = tmp_path / "cost.json"
     argv = ["--families", "random-20", "--worlds", "2", "--seconds", "0.05", "--json", str(out)]
-    assert bench["main"](argv) == 0
+    assert bench.main(argv) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert [row["layout"] for row in rows] == list(bench["LAYOUTS"])
+    assert [row["layout"] for row in rows] == list(bench.LAYOUTS)
     assert all(row["decisions_per_s"] > 0 for row in rows)
     with pytest.raises(SystemExit):
-        bench["main"](["--worlds", "0"])
+        bench.main(["--worlds", "0"])

@@ -1,19 +1,14 @@
-"""baselines/calibrate.py: the score, the fit test, and a --quick run end to end."""
+"""The calibration (baselines/calibrate.py): the score, the fit test, and a --quick run end to
+end."""
 
 from __future__ import annotations
 
 import json
-import runpy
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(scope="module")
-def calibrate() -> dict:
-    return runpy.run_path(str(REPO / "baselines" / "calibrate.py"))
+from frontier_marl.experiments.calibrate import main
+from frontier_marl.experiments.calibration_search import fits, score_of
 
 
 def row(gd: tuple[float, float], gg: tuple[float, float], n_slots: int = 4) -> dict:
@@ -24,8 +19,7 @@ def row(gd: tuple[float, float], gg: tuple[float, float], n_slots: int = 4) -> d
     }
 
 
-def test_score_is_zero_on_the_thesis_figures_and_adds_the_stated_terms(calibrate):
-    score_of = calibrate["score_of"]
+def test_score_is_zero_on_the_thesis_figures_and_adds_the_stated_terms():
     assert score_of(row((16.48, 1.78), (15.01, 1.12))) == pytest.approx(0.0)
     # mean errors 0.2 + 0.1, std errors 0.4 + 0.8 weighted 0.25
     assert score_of(row((16.68, 1.38), (14.91, 1.92))) == pytest.approx(0.3 + 0.3)
@@ -34,17 +28,16 @@ def test_score_is_zero_on_the_thesis_figures_and_adds_the_stated_terms(calibrate
     assert score_of(row((16.48, 1.78), (15.01, 1.12), n_slots=5)) == pytest.approx(1.0)
 
 
-def test_fits_needs_both_means_within_tolerance_and_greedy_distance_ahead(calibrate):
-    fits = calibrate["fits"]
+def test_fits_needs_both_means_within_tolerance_and_greedy_distance_ahead():
     assert fits(row((16.9, 0.0), (15.4, 0.0)), 0.5)
     assert not fits(row((17.0, 0.0), (15.01, 0.0)), 0.5)
     assert not fits(row((16.48, 0.0), (15.6, 0.0)), 0.5)
     assert not fits(row((15.2, 0.0), (15.3, 0.0)), 2.0)
 
 
-def test_quick_run_writes_a_complete_results_file(calibrate, tmp_path):
+def test_quick_run_writes_a_complete_results_file(tmp_path):
     out = tmp_path / "calibration.json"
-    assert calibrate["main"](["--quick", "--out", str(out)]) == 0
+    assert main(["--quick", "--out", str(out)]) == 0
     data = json.loads(out.read_text())
     winner = data["winner"]
     assert set(winner["setting"]) == set(data["reference"])

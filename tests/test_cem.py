@@ -12,6 +12,14 @@ import torch
 
 from frontier_marl import FrontierParallelEnv
 from frontier_marl.cli.main import main
+from frontier_marl.experiments.explorer_studies import (
+    ablation,
+    near_probe,
+    selection,
+    tour_sweep,
+    true_gain_probe,
+    weight_sensitivity,
+)
 from frontier_marl.policies.linear_scorer import feature_names
 from frontier_marl.training.cem import linear_model, play_t99, relative_t99, save_hand_set
 from frontier_marl.training.experiment import load_experiment
@@ -132,13 +140,9 @@ def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> Non
 
 
 def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: Path) -> None:
-    import runpy
-
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_ablation.py"
-    ablation = runpy.run_path(str(script))["main"]
     out = tmp_path / "ablation.json"
     argv = ["--episodes", "1", "--out", str(tmp_path / "models"), "--json", str(out)]
-    assert ablation([*argv, "--no-progress"]) == 0
+    assert main(ablation.benchmark_command([*argv, "--no-progress"])) == 0
     rows = json.loads(out.read_text())["rows"]
     policies = {row["policy"] for row in rows}
     expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "fill-rule", "explorer-dqn"}
@@ -149,29 +153,21 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
 
 
 def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_path: Path) -> None:
-    import runpy
-
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_selection.py"
-    selection = runpy.run_path(str(script))["main"]
     out = tmp_path / "selection.json"
     argv = ["--episodes", "1", "--heuristics", "nearest-path,cost-utility", "--json", str(out)]
-    assert selection([*argv, "--no-progress"]) == 0
+    assert selection.main([*argv, "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
     assert {row["policy"] for row in rows} == {"nearest-path", "cost-utility", "explorer"}
     assert all(row["seeds"] == [800_100] for row in rows)
     for bad in (["--first", "900000"], ["--heuristics", ""]):  # a held-out seed; no heuristic
         with pytest.raises(SystemExit):
-            selection(bad)
+            selection.main(bad)
 
 
 def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) -> None:
-    import runpy
-
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_tour_sweep.py"
-    sweep = runpy.run_path(str(script))["main"]
     out = tmp_path / "sweep.json"
     argv = ["--weights=-0.5,-1", "--episodes", "1", "--out", str(tmp_path / "m")]
-    assert sweep([*argv, "--json", str(out), "--no-progress"]) == 0
+    assert tour_sweep.main([*argv, "--json", str(out), "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
     assert {row["policy"] for row in rows} == {"nearest-path", "tour-0.5", "tour-1"}
     assert all(row["seeds"] == [700_000] for row in rows)
@@ -179,7 +175,7 @@ def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) 
     assert rule["weights"]["tour"] == -1.0 and rule["trained_by"] == "hand-set"
     for bad in (["--first", "800000"], ["--weights", "a,b"]):
         with pytest.raises(SystemExit):
-            sweep(bad)
+            tour_sweep.main(bad)
 
 
 def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
@@ -188,24 +184,20 @@ def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
 
 
 def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> None:
-    import runpy
-
     from frontier_marl.policies.linear_scorer import weight_vector
     from frontier_marl.sim.features import NEAR
     from frontier_marl.training.cem import play_scorer
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_near_probe.py"
-    probe = runpy.run_path(str(script))
     cfg = load_experiment("explorer", ["env.unknown_near=false"]).env_configs()[2]  # rooms-32
     seeds = [5, 6, 7]
-    t99, _ = play_scorer(cfg, seeds, probe["scorer"](feature_names(cfg), NEAR, -0.5))
+    t99, _ = play_scorer(cfg, seeds, near_probe.scorer(feature_names(cfg), NEAR, -0.5))
     featured = load_experiment("explorer", ["env.unknown_near=true"]).env_configs()[2]
     rule = {"path": -1.0, "tour": -0.5, "unknown_near": -0.5}
     expected, _ = play_t99(featured, seeds, weight_vector(rule, feature_names(featured), "rule"))
     assert np.array_equal(t99, expected, equal_nan=True)
     out = tmp_path / "probe.json"
     argv = ["--radii", "8", "--weights=-0.4", "--episodes", "1", "--json", str(out)]
-    assert probe["main"](argv) == 0
+    assert near_probe.main(argv) == 0
     rows = json.loads(out.read_text())["rows"]
     assert [row["family"] for row in rows] == [
         "random-20", "random-30", "rooms-32", "rooms-64", "rooms-96-fine", "floorplan-96"
@@ -213,22 +205,18 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
     assert all(set(row) == {"family", "rule", "R8 W-0.4"} for row in rows)
     for bad in (["--first", "800000"], ["--radii", "a"]):
         with pytest.raises(SystemExit):
-            probe["main"](bad)
+            near_probe.main(bad)
 
 
 def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_path: Path) -> None:
-    import runpy
-
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_weight_sensitivity.py"
-    sensitivity = runpy.run_path(str(script))
     names = ["path", "size", "tour", "unknown_near"]
     weights = np.array([-1.0, 0.8, -0.5, -0.4])
-    lengths = sensitivity["scaled"](weights, names, "lengths", 2.0)
-    assert lengths.tolist() == [-2.0, 0.8, -1.0, -0.4]
-    assert sensitivity["scaled"](weights, names, "size", 0.5).tolist() == [-1.0, 0.4, -0.5, -0.4]
+    scaled = weight_sensitivity.scaled
+    assert scaled(weights, names, "lengths", 2.0).tolist() == [-2.0, 0.8, -1.0, -0.4]
+    assert scaled(weights, names, "size", 0.5).tolist() == [-1.0, 0.4, -0.5, -0.4]
     out = tmp_path / "sensitivity.json"
     argv = ["--directions", "tour:1,lengths:3", "--seed-sets", "730000,731000", "--episodes", "2"]
-    assert sensitivity["main"]([*argv, "--json", str(out)]) == 0
+    assert weight_sensitivity.main([*argv, "--json", str(out)]) == 0
     rows = json.loads(out.read_text())["rows"]
     assert len(rows) == 6 * 2 * 2  # families x seed sets x directions
     unchanged = [row for row in rows if row["direction"] == "tour:1"]
@@ -243,21 +231,18 @@ def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_p
     )
     for bad in bad_inputs:
         with pytest.raises(SystemExit):
-            sensitivity["main"](bad)
+            weight_sensitivity.main(bad)
 
 
 def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_path: Path) -> None:
-    import runpy
-
     from frontier_marl.training.cem import play_scorer
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_true_gain_probe.py"
-    probe = runpy.run_path(str(script))
     cfg = load_experiment("explorer").env_configs()[2]  # rooms-32
     checked = []
 
     def score(observations: dict, env) -> np.ndarray:
-        true, belief = probe["disc_gains"](env, "true"), probe["disc_gains"](env, "belief")
+        true = true_gain_probe.disc_gains(env, "true")
+        belief = true_gain_probe.disc_gains(env, "belief")
         valid = observations["action_mask"].astype(bool)
         assert np.all(true[~valid] == 0) and np.all(belief[~valid] == 0)
         assert np.all((true >= 0) & (true <= belief + 1e-12) & (belief <= 1))
@@ -268,7 +253,7 @@ def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_
     assert len(checked) > 10 and sum(checked) > 0  # decisions with something to reveal
     out = tmp_path / "probe.json"
     argv = ["--weights=0,0.1", "--kinds", "true", "--episodes", "2", "--json", str(out)]
-    assert probe["main"](argv) == 0
+    assert true_gain_probe.main(argv) == 0
     rows = json.loads(out.read_text())["rows"]
     assert len(rows) == 6 * 2  # families x weights
     assert all(row["change"] == 0.0 for row in rows if row["weight"] == 0)
@@ -279,7 +264,7 @@ def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_
         ["--episodes", "1"],
     ):
         with pytest.raises(SystemExit):
-            probe["main"](bad)
+            true_gain_probe.main(bad)
 
 
 def test_paired_change_is_the_mean_relative_t99_and_its_standard_error() -> None:

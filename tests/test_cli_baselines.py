@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from frontier_marl.cli.arguments import parse_set_options, parse_value
 from frontier_marl.cli.main import main
+from frontier_marl.utils.set_options import parse_set_options, parse_value
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 SMALL = [

@@ -1,16 +1,15 @@
-"""training/evaluate_checkpoints.py on a tiny run with three checkpoints."""
+"""The checkpoint evaluation of training/evaluate_checkpoints.py on a tiny run with three
+checkpoints."""
 
 from __future__ import annotations
 
 import json
-import runpy
 from pathlib import Path
 
 import pytest
 
+from frontier_marl.experiments.evaluate_checkpoints import evaluate_checkpoints, main
 from frontier_marl.training.experiment import experiment_from_dict
-
-REPO = Path(__file__).resolve().parents[1]
 
 
 def test_one_row_per_checkpoint_and_seed(tmp_path: Path) -> None:
@@ -33,7 +32,6 @@ def test_one_row_per_checkpoint_and_seed(tmp_path: Path) -> None:
     )
     run = tmp_path / "run"
     train(experiment, run, progress_bar=False)
-    main = runpy.run_path(str(REPO / "training" / "evaluate_checkpoints.py"))["main"]
     out = tmp_path / "curve.json"
     assert main([str(run), "--seeds", "1000", "0", "--episodes", "2", "--json", str(out)]) == 0
     rows = json.loads(out.read_text())
@@ -45,8 +43,5 @@ def test_one_row_per_checkpoint_and_seed(tmp_path: Path) -> None:
 
 
 def test_a_run_without_checkpoints_is_refused(tmp_path: Path) -> None:
-    evaluate = runpy.run_path(str(REPO / "training" / "evaluate_checkpoints.py"))[
-        "evaluate_checkpoints"
-    ]
     with pytest.raises(ValueError, match="no checkpoints"):
-        evaluate(tmp_path, [0])
+        evaluate_checkpoints(tmp_path, [0])

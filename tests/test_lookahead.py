@@ -113,19 +113,15 @@ def test_imitation_labels_real_decisions_and_fits_them() -> None:
 
 
 def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
-    import runpy
-    from pathlib import Path
-
     from frontier_marl import FrontierParallelEnv
     from frontier_marl.core.slots import SlotArrays
+    from frontier_marl.experiments.explorer_studies.rollout_probe import LinearScorerBase
     from frontier_marl.policies.linear_scorer import feature_names
     from frontier_marl.policies.models import load_model
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
-    probe = runpy.run_path(str(script))
     cfg = load_model("explorer").env_config()
     path_only = np.array([-1.0 if name == "path" else 0.0 for name in feature_names(cfg)])
-    base = probe["LinearScorerBase"](cfg, path_only)  # nearest-path among the 12 slots
+    base = LinearScorerBase(cfg, path_only)  # nearest-path among the 12 slots
     env = FrontierParallelEnv(config=cfg)
     for seed in range(5):
         env.reset(seed=seed)
@@ -144,11 +140,9 @@ def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
 
 def test_the_rollout_probe_scores_both_oracles_on_validation_episodes(tmp_path) -> None:
     import json
-    import runpy
-    from pathlib import Path
 
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "explorer_rollout_probe.py"
-    probe = runpy.run_path(str(script))["main"]
+    from frontier_marl.experiments.explorer_studies.rollout_probe import main as probe
+
     out = tmp_path / "probe.json"
     assert (
         probe(["--families", "random-20", "--episodes", "2", "--json", str(out), "--no-progress"])

@@ -22,8 +22,8 @@ from frontier_marl.core.example_maps import (
 )
 from frontier_marl.core.map_files import format_text_map, load_map, parse_pgm, parse_text_map
 from frontier_marl.core.maps import FOUR_CONNECTED, floorplan_map, rooms_map
+from frontier_marl.experiments import make_example_maps
 
-REPO = Path(__file__).resolve().parents[1]
 # CI keeps a copy of shared/ beside the clone; locally it is ../shared as well.
 EXPLORE_BENCH = Path(__file__).resolve().parents[2] / "shared" / "maps" / "explore-bench"
 
@@ -376,10 +376,7 @@ def test_example_map_names_resolve_and_unknown_names_fail():
 
 
 def test_example_maps_script_check_passes():
-    import runpy
-
-    module = runpy.run_path(str(REPO / "baselines" / "make_example_maps.py"))
-    assert module["main"](["--check"]) == 0
+    assert make_example_maps.main(["--check"]) == 0
 
 
 @pytest.mark.parametrize(

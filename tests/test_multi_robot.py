@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import runpy
 import warnings
 from pathlib import Path
 from typing import Any
@@ -24,6 +23,7 @@ from frontier_marl.core.example_maps import example_map_path
 from frontier_marl.core.grid import FREE, OCCUPIED
 from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.metrics import makespan_curve, overlap_ratio
+from frontier_marl.experiments import multi_robot, multi_robot_tables
 from frontier_marl.policies import (
     TEAM_POLICIES,
     CoordinatedAssignment,
@@ -33,8 +33,6 @@ from frontier_marl.policies import (
 from frontier_marl.sim.rewards import StepEvents, step_outcome
 from tests.helpers import info_with, live_slot
 from tests.oracles import bfs as bfs_distances
-
-REPO = Path(__file__).resolve().parents[1]
 
 # A 1 x 11 corridor inside walls: with range 1 each robot senses its 3 x 3 window.
 CORRIDOR = "#" * 13 + "\n#" + "." * 11 + "#\n" + "#" * 13 + "\n"
@@ -671,7 +669,6 @@ def test_map_generator_and_map_options(tmp_path, capsys):
 
 
 def test_multi_robot_experiment_script_runs(tmp_path):
-    module = runpy.run_path(str(REPO / "baselines" / "multi_robot.py"))
     settings_ = {
         "tiny": {
             "map_path": str(example_map_path("rooms-32")),
@@ -683,20 +680,20 @@ def test_multi_robot_experiment_script_runs(tmp_path):
         name: (lambda name=name: make_policy(name))
         for name in ("greedy-distance", "coordinated-assignment")
     }
-    rows = module["run_experiment"](settings_, policies, [1, 2], episodes=2, log=lambda _: None)
+    rows = multi_robot.run_experiment(settings_, policies, [1, 2], episodes=2, log=lambda _: None)
     assert [(r["n_agents"], r["policy"]) for r in rows] == [
         (1, "greedy-distance"),
         (1, "coordinated-assignment"),
         (2, "greedy-distance"),
         (2, "coordinated-assignment"),
     ]
-    table = module["results_table"](rows)
+    table = multi_robot_tables.results_table(rows)
     assert table.count("\n") == 5 and "| tiny | 2 | coordinated-assignment |" in table
-    entries = module["comparison"](rows)
+    entries = multi_robot_tables.comparison(rows)
     assert len(entries) == 1 and entries[0]["n_agents"] == 2
     overlap = entries[0]["overlap"]
     assert overlap["wins"] + overlap["ties"] + overlap["losses"] == 2
-    assert "coordinated-assignment" in module["comparison_table"](entries)
+    assert "coordinated-assignment" in multi_robot_tables.comparison_table(entries)
     from frontier_marl.evaluation.plots import plot_team_comparison
 
     plot_team_comparison(rows, tmp_path / "tiny.png", title="tiny")

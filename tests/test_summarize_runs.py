@@ -1,14 +1,13 @@
-"""training/summarize_runs.py on a tiny run: the summary holds what docs cite, no artefacts."""
+"""The run summaries of training/summarize_runs.py on a tiny run: the summary holds what docs
+cite, no artefacts."""
 
 from __future__ import annotations
 
 import json
-import runpy
 from pathlib import Path
 
 from frontier_marl.cli.main import main as cli
-
-REPO = Path(__file__).resolve().parents[1]
+from frontier_marl.experiments.summarize_runs import main
 
 
 def test_a_run_folder_becomes_one_small_summary(tmp_path: Path) -> None:
@@ -16,7 +15,6 @@ def test_a_run_folder_becomes_one_small_summary(tmp_path: Path) -> None:
     args = ["train", "config01", "--steps", "1200", "--out", str(run_dir), "--no-progress"]
     sets = ["train.validate_every=600", "train.validation_episodes=2", "train.eval_episodes=2"]
     assert cli([*args, *[x for s in sets for x in ("--set", s)]]) == 0
-    main = runpy.run_path(str(REPO / "training" / "summarize_runs.py"))["main"]
     out = tmp_path / "summaries"
     assert main([str(run_dir), "--out", str(out), "--machine", "test", "--window", "400"]) == 0
     summary = json.loads((out / "run.json").read_text())

@@ -52,12 +52,10 @@ def test_team_configs(config: str, shape: tuple[int, int], map_file: str | None)
 
 def test_multi_robot_comparison_of_a_policy_that_never_reaches_a_level() -> None:
     import copy
-    import runpy
-    from pathlib import Path
 
+    from frontier_marl.experiments import multi_robot, multi_robot_tables
     from frontier_marl.policies import make_policy
 
-    module = runpy.run_path(str(Path(__file__).resolve().parents[1] / "baselines/multi_robot.py"))
     settings_ = {
         "tiny": {
             "map_path": str(example_map_path("rooms-32")),
@@ -65,7 +63,7 @@ def test_multi_robot_comparison_of_a_policy_that_never_reaches_a_level() -> None
             "no_progress_limit": 200,
         }
     }
-    rows = module["run_experiment"](
+    rows = multi_robot.run_experiment(
         settings_,
         {"greedy-distance": lambda: make_policy("greedy-distance")},
         [2],
@@ -76,12 +74,12 @@ def test_multi_robot_comparison_of_a_policy_that_never_reaches_a_level() -> None
     stuck["policy"] = "stuck"
     for episode in stuck["per_episode"]:
         episode["makespan_to_coverage"]["0.99"] = None
-    entries = module["comparison"]([rows[0], stuck])
+    entries = multi_robot_tables.comparison([rows[0], stuck])
     assert len(entries) == 1
     assert entries[0]["makespan@0.99"]["episodes"] == 0
     assert entries[0]["makespan@0.99"]["change"] is None
     assert entries[0]["overlap"]["episodes"] == 2
-    table = module["comparison_table"](entries)
+    table = multi_robot_tables.comparison_table(entries)
     assert "no paired episode" in table and "nan" not in table
-    endings = module["endings_table"]([rows[0]])
+    endings = multi_robot_tables.endings_table([rows[0]])
     assert "| tiny | 2 | greedy-distance | 1.000 | threshold 2 |" in endings

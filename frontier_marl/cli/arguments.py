@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Any
 
 from frontier_marl.config import PRESETS, make_config
 from frontier_marl.core.example_maps import example_map_names
 from frontier_marl.policies import POLICIES
+from frontier_marl.utils.set_options import parse_set_options
 
 
 def int_at_least(low: int) -> Callable[[str], int]:
@@ -56,34 +57,6 @@ def int_list(low: int) -> Callable[[str], list[int]]:
         return values
 
     return parse
-
-
-def parse_value(text: str) -> Any:
-    """A ``--set`` value: int, float, bool (true/false), None (none), else the string
-    (e.g. ``full``, ``raycast``)."""
-    lowered = text.strip().lower()
-    if lowered in ("true", "false"):
-        return lowered == "true"
-    if lowered in ("none", "null"):
-        return None
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text.strip()
-
-
-def parse_set_options(items: Sequence[str] | None) -> dict[str, Any]:
-    """``["key=value", ...]`` -> ``{key: parsed value}``; ValueError on a malformed item."""
-    out: dict[str, Any] = {}
-    for item in items or []:
-        key, sep, value = item.partition("=")
-        key = key.strip().replace("-", "_")
-        if not sep or not key:
-            raise ValueError(f"--set expects key=value, got {item!r}")
-        out[key] = parse_value(value)
-    return out
 
 
 def add_set_argument(parser: argparse.ArgumentParser, help_text: str) -> None:

@@ -14,7 +14,8 @@ with its costs for a student that sees only its own observation.
 The base policy of the simulations keeps a target while it is still a frontier cell and then
 picks the next one: by default the nearest cluster by known-free path (ties: nearest
 centroid, :class:`NearestPathBase`), one cell per move; any :class:`RolloutBase` can take its
-place (benchmarks/explorer_rollout_probe.py finishes the simulations with the explorer).
+place (:mod:`frontier_marl.experiments.explorer_studies.rollout_probe` finishes the
+simulations with the explorer).
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ dispatcher.
   (learn, checkpoints, Ctrl-C, evaluation).
 * :mod:`~frontier_marl.training.cem`: the cross-entropy method on the linear slot scorer.
 * :mod:`~frontier_marl.training.imitation`: DAgger labels from the lookahead oracle and the fit
-  of a slot Q-network to them (``benchmarks/imitation_probe.py``).
+  of a slot Q-network to them (:mod:`frontier_marl.experiments.explorer_studies.imitation_probe`).
 * :mod:`~frontier_marl.training.batched_vec_env`: the batched vector env as an SB3 ``VecEnv``
   (the default), and ``MixedVecEnv`` for several map families;
   :mod:`~frontier_marl.training.vec_env`: ParallelEnv -> SuperSuit -> SB3 vector env.

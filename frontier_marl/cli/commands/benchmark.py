@@ -24,7 +24,6 @@ from pathlib import Path
 from frontier_marl.cli.arguments import (
     add_set_argument,
     fail,
-    parse_set_options,
     positive_int,
 )
 from frontier_marl.evaluation.benchmark import families as map_families
@@ -32,6 +31,7 @@ from frontier_marl.evaluation.benchmark import run as bench
 from frontier_marl.evaluation.benchmark.families import DEFAULT_EPISODES, FAMILIES, SPLITS
 from frontier_marl.evaluation.benchmark.stats import format_table, plot_benchmark
 from frontier_marl.utils.json_files import write_json
+from frontier_marl.utils.set_options import parse_set_options
 
 #: The default heuristics: the thesis's two, cost-utility and nearest-path; teams add the joint
 #: ones.

@@ -24,7 +24,6 @@ from frontier_marl.cli.arguments import (
     add_set_argument,
     non_negative_int,
     parse_policies,
-    parse_set_options,
     positive_int,
 )
 from frontier_marl.config import PRESETS
@@ -36,6 +35,7 @@ from frontier_marl.evaluation.model_evaluation import (
 from frontier_marl.policies.metadata import ModelEnvMismatchError
 from frontier_marl.policies.models import load_model
 from frontier_marl.utils.progress import progress_bar
+from frontier_marl.utils.set_options import parse_set_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,0 +1,105 @@
+"""How far below the explorer one step of lookahead on the true map goes: a privileged bound.
+
+``lookahead-oracle`` simulates each candidate cluster on the true map and lets nearest-path
+finish (rollout on nearest-path). ``explorer-rollout`` is the same with the shipped
+``explorer`` finishing each simulation (its observation and weights), so it is one step of
+policy improvement over the explorer itself, and its costs are the labels a student of the
+explorer would need. Both read the true map: bounds, not contenders. Validation episodes::
+
+    python benchmarks/explorer_rollout_probe.py --families random-20,random-30,rooms-32 \\
+        --episodes 16 --json training/results/explorer/rollout-probe.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.worlds import Worlds
+from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, model, run_benchmark
+from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.policies.lookahead import LookaheadOracle
+from frontier_marl.sim.observations import ObservationEncoder
+from frontier_marl.training.cem import shipped_weights
+
+
+class LinearScorerBase:
+    """A rollout base policy (:class:`~frontier_marl.policies.lookahead.RolloutBase`): the
+    linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own; the
+    simulations keep no heading, so the ``current`` feature reads 0)."""
+
+    def __init__(self, cfg: EnvConfig, weights: np.ndarray) -> None:
+        self.encoder = ObservationEncoder(cfg)
+        self.weights = weights
+        self.n_slots = cfg.n_slots
+        self.gain = cfg.gain
+
+    def goals(self, sims: Worlds, slots: SlotArrays, deciding: np.ndarray) -> np.ndarray:
+        rows = slots.rows(deciding)
+        positions = sims.positions[deciding, 0]
+        observed = self.encoder.encode_batch(rows, positions, beliefs=sims.belief[deciding])
+        scores = np.where(rows.valid, observed["slots"].astype(np.float64) @ self.weights, -np.inf)
+        best = np.argmax(scores, axis=1)
+        goals = rows.target[np.arange(len(deciding)), best].astype(np.int64)
+        goals[~rows.valid.any(axis=1)] = -1
+        return goals
+
+
+class ExplorerRollout(LookaheadOracle):
+    """The lookahead oracle whose rollouts the linear scorer ``weights`` (by feature name)
+    finishes, on the observation of the env it is attached to (the model's own, on the
+    family's world)."""
+
+    name = "explorer-rollout"
+
+    def __init__(self, weights: Mapping[str, float]) -> None:
+        super().__init__()
+        self.weights = weights
+
+    def attach(self, env: Any) -> None:
+        super().attach(env)
+        vector = weight_vector(self.weights, feature_names(env.config), "the scorer's weights")
+        self.base = LinearScorerBase(env.config, vector)
+
+
+def explorer_rollout() -> Contender:
+    """``explorer-rollout`` with the shipped explorer's weights, in the explorer's env."""
+    weights = shipped_weights()
+    return Contender(
+        ExplorerRollout.name, False, lambda: ExplorerRollout(weights), model("explorer").config
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--families", default="random-20,random-30,rooms-32")
+    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    names = args.families.split(",")
+    try:
+        check_families(names, "--families")
+    except ValueError as exc:
+        parser.error(f"{exc} (valid: {', '.join(FAMILIES)})")
+    policies = [*contenders(["nearest-path", "explorer", "lookahead-oracle"]), explorer_rollout()]
+    rows = run_benchmark(
+        [family(name) for name in names],
+        policies,
+        args.episodes,
+        progress=not args.no_progress,
+        split="validation",
+    )
+    print(format_table(rows))
+    if args.json is not None:
+        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
+    return 0
