@@ -8,8 +8,11 @@ beside nearest-path, explorer-dqn and explorer with ``frontier-marl benchmark`` 
 episodes. The policies and the options: :mod:`frontier_marl.experiments.explorer_studies.ablation`.
 """
 
+from pathlib import Path
+
 from frontier_marl.cli.main import main as cli
 from frontier_marl.experiments.explorer_studies.ablation import benchmark_command
 
 if __name__ == "__main__":
-    raise SystemExit(cli(benchmark_command()))
+    explorer_dqn = Path(__file__).resolve().parents[1] / "training" / "models" / "explorer-dqn"
+    raise SystemExit(cli(benchmark_command(explorer_dqn=explorer_dqn)))

@@ -25,6 +25,9 @@ from frontier_marl.training.cem import linear_model, play_t99, relative_t99, sav
 from frontier_marl.training.experiment import load_experiment
 from frontier_marl.training.settings import CEMSettings
 
+#: The DQN-trained slot scorer of the explorer studies (in the repository, not the wheel)
+EXPLORER_DQN = Path(__file__).resolve().parents[1] / "training" / "models" / "explorer-dqn"
+
 CEM_OVERRIDES = [
     "train.algorithm=cem",
     "train.families=['random-20', 'rooms-32']",
@@ -142,7 +145,7 @@ def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> Non
 def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: Path) -> None:
     out = tmp_path / "ablation.json"
     argv = ["--episodes", "1", "--out", str(tmp_path / "models"), "--json", str(out)]
-    assert main(ablation.benchmark_command([*argv, "--no-progress"])) == 0
+    assert main(ablation.benchmark_command([*argv, "--no-progress"], EXPLORER_DQN)) == 0
     rows = json.loads(out.read_text())["rows"]
     policies = {row["policy"] for row in rows}
     expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "fill-rule", "explorer-dqn"}

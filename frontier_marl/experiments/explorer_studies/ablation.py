@@ -10,7 +10,8 @@ ones), with ``frontier-marl benchmark``:
 * ``near-rule``: the tour rule plus a hand-set ``unknown_near`` weight of -0.5, no learning;
 * ``fill-rule``: the near rule plus hand-set ``size`` 0.8 and ``fill`` -0.4 weights (where
   CEM starts): long frontier pieces before specks on fine grids, about neutral on coarse ones;
-* ``explorer-dqn``: the DQN-trained slot scorer (no tour feature);
+* ``explorer-dqn``: the DQN-trained slot scorer (no tour feature; a research model in the
+  repository's ``training/models/``, not in the wheel);
 * ``explorer``: the shipped CEM-trained linear scorer (with the tour, unknown-near and fill
   features);
 * any further model given with ``--models`` (e.g. a CEM run without the tour feature:
@@ -45,11 +46,17 @@ def save_rules(out: Path) -> list[str]:
     return [str(out / label) for label in HAND_SET]
 
 
-def benchmark_command(argv: list[str] | None = None) -> list[str]:
+#: The DQN-trained slot scorer, from the repository's root.
+EXPLORER_DQN = Path("training/models/explorer-dqn")
+
+
+def benchmark_command(
+    argv: list[str] | None = None, explorer_dqn: Path = EXPLORER_DQN
+) -> list[str]:
     """The command line of ``benchmarks/explorer_ablation.py``: saves the hand-set rules under
     ``--out`` and returns the ``frontier-marl benchmark`` arguments that score them beside the
     other policies (the script runs them with :func:`frontier_marl.cli.main.main`; the CLI is
-    the layer above this one)."""
+    the layer above this one). ``explorer_dqn`` is the folder of the DQN-trained scorer."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=64, help="validation episodes per family")
     parser.add_argument("--models", default="", help="comma-separated extra model folders")
@@ -57,7 +64,7 @@ def benchmark_command(argv: list[str] | None = None) -> list[str]:
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    policies = ["nearest-path", *save_rules(args.out), "explorer-dqn", "explorer"]
+    policies = ["nearest-path", *save_rules(args.out), str(explorer_dqn), "explorer"]
     policies += [m for m in args.models.split(",") if m]
     command = ["benchmark", "--split", "validation", "--episodes", str(args.episodes)]
     command += ["--policies", ",".join(policies)]
