@@ -305,6 +305,7 @@ def test_cli_agents_must_be_positive(agents, capsys):
     assert "expected an integer >= 1" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not EXPLORE_BENCH.is_dir(), reason=f"{EXPLORE_BENCH} is absent")
 def test_cli_explore_bench_folder(tmp_path):
     out = tmp_path / "eb.json"

@@ -19,6 +19,8 @@ pytest.importorskip("supersuit")
 
 from frontier_marl.cli.main import main  # noqa: E402
 
+pytestmark = pytest.mark.slow  # starts a local Ray instance
+
 CONFIGS = ("config01", "config04")
 
 

@@ -122,6 +122,7 @@ def test_the_linear_model_scores_slots_by_their_features() -> None:
     assert (q_values[torch.as_tensor(~valid)] <= -1e8).all()
 
 
+@pytest.mark.slow
 def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> None:
     run_dir = tmp_path / "cem"
     tiny = ["cem.generations=2", "cem.population=3", "cem.elite=2", "cem.episodes=1"]
@@ -142,6 +143,7 @@ def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> Non
     assert rows[1]["success"] == 1.0
 
 
+@pytest.mark.slow
 def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: Path) -> None:
     out = tmp_path / "ablation.json"
     argv = ["--episodes", "1", "--out", str(tmp_path / "models"), "--json", str(out)]
@@ -155,6 +157,7 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
     assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
 
 
+@pytest.mark.slow
 def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_path: Path) -> None:
     out = tmp_path / "selection.json"
     argv = ["--episodes", "1", "--heuristics", "nearest-path,cost-utility", "--json", str(out)]
@@ -167,6 +170,7 @@ def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_pat
             selection.main(bad)
 
 
+@pytest.mark.slow
 def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) -> None:
     out = tmp_path / "sweep.json"
     argv = ["--weights=-0.5,-1", "--episodes", "1", "--out", str(tmp_path / "m")]
@@ -186,6 +190,7 @@ def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
         save_hand_set({"path": -1.0, "tuor": -0.5}, tmp_path, load_experiment("explorer"))
 
 
+@pytest.mark.slow
 def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> None:
     from frontier_marl.policies.linear_scorer import weight_vector
     from frontier_marl.sim.features import NEAR
@@ -211,6 +216,7 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
             near_probe.main(bad)
 
 
+@pytest.mark.slow
 def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_path: Path) -> None:
     names = ["path", "size", "tour", "unknown_near"]
     weights = np.array([-1.0, 0.8, -0.5, -0.4])
@@ -237,6 +243,7 @@ def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_p
             weight_sensitivity.main(bad)
 
 
+@pytest.mark.slow
 def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_path: Path) -> None:
     from frontier_marl.training.cem import play_scorer
 

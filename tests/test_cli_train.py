@@ -211,6 +211,7 @@ def test_evaluate_the_shipped_model_by_name(tmp_path: Path, capsys) -> None:
     assert model["episodes"] == 2 and sum(model["action_shares"]) == pytest.approx(1.0)
 
 
+@pytest.mark.slow
 def test_train_the_explorer_on_families_and_benchmark_it(tmp_path: Path, capsys) -> None:
     """The shipped explorer config trains (tiny budget) on the four families with the slot
     scorer, resumes, and the benchmark runs the model on validation episodes of every size."""

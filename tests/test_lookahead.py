@@ -138,6 +138,7 @@ def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
     env.close()
 
 
+@pytest.mark.slow
 def test_the_rollout_probe_scores_both_oracles_on_validation_episodes(tmp_path) -> None:
     import json
 

@@ -21,6 +21,8 @@ from frontier_marl.training.checkpoints import list_checkpoints  # noqa: E402
 from frontier_marl.training.experiment import experiment_from_dict  # noqa: E402
 from frontier_marl.training.workers import TrainJob, train_runs  # noqa: E402
 
+pytestmark = pytest.mark.slow  # trains in worker processes
+
 
 def tiny(seed: int, steps: int = 1500) -> object:
     return experiment_from_dict(

@@ -239,6 +239,7 @@ def test_reproduce_reports_the_best_validated_policy_beside_the_final_model(
     assert f"best-validated policy (step {step}," in (result.out / "comparison.md").read_text()
 
 
+@pytest.mark.slow
 def test_reproduce_with_two_seeds_pools_them_and_reports_each(tmp_path: Path) -> None:
     config = tmp_path / "validated.toml"
     config.write_text(VALIDATED_CONFIG)

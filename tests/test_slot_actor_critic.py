@@ -201,6 +201,7 @@ def test_ppo_overrides_find_their_section() -> None:
     assert "dqn" not in saved and experiment_from_dict(saved) == experiment
 
 
+@pytest.mark.slow
 def test_train_explorer_ppo_resume_and_benchmark(tmp_path: Path) -> None:
     """The shipped explorer-ppo config trains (tiny budget), resumes, records its algorithm,
     loads as MaskablePPO and runs in the benchmark."""
