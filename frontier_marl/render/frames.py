@@ -12,6 +12,15 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.grid import FREE, OCCUPIED
+from frontier_marl.render.drawing import (
+    GRID_LINE_MIN_PX,
+    cell_center_px,
+    draw_hollow_square,
+    draw_polyline,
+    fill_disc,
+    grid_lines,
+    upscale,
+)
 
 __all__ = [
     "CLUSTER_PALETTE",
@@ -64,9 +73,6 @@ ROBOT_PALETTE = np.array(
     ],
     dtype=np.uint8,
 )
-
-_GRID_LINE_MIN_PX = 6
-_GRID_LINE_FACTOR = 0.8
 
 
 # --------------------------------------------------------------------------- validation
@@ -137,77 +143,6 @@ def frame_shape(grid_shape: tuple[int, int], cell_px: int = 12) -> tuple[int, in
     return (h * cell_px, (2 * w + 1) * cell_px, 3)
 
 
-def _cell_center_px(rc: np.ndarray, cell_px: int) -> np.ndarray:
-    """Pixel coordinates (float) of the centre of (possibly fractional) cell coordinates."""
-    return np.asarray(rc, dtype=np.float64) * cell_px + (cell_px - 1) / 2.0
-
-
-def _fill_disc(
-    img: np.ndarray, cy: float, cx: float, radius: float, color: np.ndarray, x0: int, x1: int
-) -> None:
-    """Fill a disc into ``img``, clipped to the columns ``[x0, x1)`` (one panel)."""
-    h = img.shape[0]
-    r0, r1 = max(int(np.floor(cy - radius)), 0), min(int(np.ceil(cy + radius)) + 1, h)
-    c0, c1 = max(int(np.floor(cx - radius)), x0), min(int(np.ceil(cx + radius)) + 1, x1)
-    if r0 >= r1 or c0 >= c1:
-        return
-    yy = np.arange(r0, r1, dtype=np.float64)[:, None] - cy
-    xx = np.arange(c0, c1, dtype=np.float64)[None, :] - cx
-    mask = yy * yy + xx * xx <= radius * radius
-    img[r0:r1, c0:c1][mask] = color
-
-
-def _draw_polyline(
-    img: np.ndarray, pts: np.ndarray, width: int, color: np.ndarray, x0: int, x1: int
-) -> None:
-    """Draw a polyline through float pixel points ``pts`` (L, 2), clipped to columns [x0, x1)."""
-    if len(pts) < 2:
-        return
-    seg = np.diff(pts, axis=0)
-    n = np.maximum(np.ceil(np.abs(seg).max(axis=1) * 2).astype(np.int64), 1)
-    idx = np.repeat(np.arange(len(seg)), n)
-    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
-    samples = pts[idx] + seg[idx] * t[:, None]
-    samples = np.vstack([samples, pts[-1:]])
-    half = (width - 1) / 2.0
-    offs = np.arange(width, dtype=np.float64) - half
-    oy, ox = np.meshgrid(offs, offs, indexing="ij")
-    all_pts = samples[:, None, :] + np.stack([oy.ravel(), ox.ravel()], axis=1)[None]
-    ij = np.rint(all_pts.reshape(-1, 2)).astype(np.int64)
-    keep = (ij[:, 0] >= 0) & (ij[:, 0] < img.shape[0]) & (ij[:, 1] >= x0) & (ij[:, 1] < x1)
-    ij = ij[keep]
-    img[ij[:, 0], ij[:, 1]] = color
-
-
-def _draw_hollow_square(
-    img: np.ndarray, row: int, col: int, cell_px: int, thick: int, color: np.ndarray, x_off: int
-) -> None:
-    """Outline the cell ``(row, col)`` with a border ``thick`` pixels wide."""
-    y0, x0 = row * cell_px, x_off + col * cell_px
-    y1, x1 = y0 + cell_px, x0 + cell_px
-    t = min(thick, max(cell_px // 2, 1))
-    img[y0 : y0 + t, x0:x1] = color
-    img[y1 - t : y1, x0:x1] = color
-    img[y0:y1, x0 : x0 + t] = color
-    img[y0:y1, x1 - t : x1] = color
-
-
-def _upscale(cells_rgb: np.ndarray, cell_px: int) -> np.ndarray:
-    if cell_px == 1:
-        return cells_rgb
-    return np.repeat(np.repeat(cells_rgb, cell_px, axis=0), cell_px, axis=1)
-
-
-def _grid_lines(panel: np.ndarray, cell_px: int) -> None:
-    """Darken the first pixel row/column of every cell except the outer ones, in place."""
-    if cell_px < _GRID_LINE_MIN_PX:
-        return
-    rows = np.arange(cell_px, panel.shape[0], cell_px)
-    cols = np.arange(cell_px, panel.shape[1], cell_px)
-    panel[rows, :] = (panel[rows, :] * _GRID_LINE_FACTOR).astype(np.uint8)
-    panel[:, cols] = (panel[:, cols] * _GRID_LINE_FACTOR).astype(np.uint8)
-
-
 # --------------------------------------------------------------------------- public API
 
 
@@ -248,39 +183,68 @@ def render_rgb(
             f"belief shape {belief.shape} does not match true_grid shape {true_grid.shape}"
         )
     shape: tuple[int, int] = (int(true_grid.shape[0]), int(true_grid.shape[1]))
-    h, w = shape
     positions = _as_cells(positions, "positions")
     _check_in_bounds(positions, "positions", shape)
     n_robots = positions.shape[0]
     labels = _check_labels(cluster_labels, shape)
+    cents = _check_centroids(centroids)
+    path_list = _check_paths(paths, n_robots, shape)
+    tgt = None if targets is None else _check_targets(targets, n_robots, shape)
 
-    cents: np.ndarray | None = None
-    if centroids is not None:
-        cents = np.asarray(centroids, dtype=np.float64)
-        if cents.size == 0:
-            cents = cents.reshape(0, 2)
-        if cents.ndim != 2 or cents.shape[1] != 2:
-            raise ValueError(f"centroids must have shape (K, 2), got {cents.shape}")
+    frame = _panels(true_grid, belief, labels, cell_px)
+    pw = shape[1] * cell_px
+    offsets = (0, pw + cell_px)  # column offset of each panel in pixels
+    robot_colors = ROBOT_PALETTE[np.arange(n_robots) % len(ROBOT_PALETTE)]
+    if cents is not None:
+        _draw_centroids(frame, cents, cell_px, offsets[1], pw)
+    if tgt is not None:
+        _draw_targets(frame, tgt, robot_colors, cell_px, offsets)
+    _draw_paths(frame, path_list, robot_colors, cell_px, offsets, pw)
+    _draw_robots(frame, positions, robot_colors, cell_px, offsets, pw)
+    return frame
 
+
+def _check_centroids(centroids: np.ndarray | None) -> np.ndarray | None:
+    if centroids is None:
+        return None
+    cents = np.asarray(centroids, dtype=np.float64)
+    if cents.size == 0:
+        cents = cents.reshape(0, 2)
+    if cents.ndim != 2 or cents.shape[1] != 2:
+        raise ValueError(f"centroids must have shape (K, 2), got {cents.shape}")
+    return cents
+
+
+def _check_paths(
+    paths: list[np.ndarray] | None, n_robots: int, shape: tuple[int, int]
+) -> list[np.ndarray | None]:
     path_list: list[np.ndarray | None] = []
-    if paths is not None:
-        if len(paths) != n_robots:
-            raise ValueError(f"paths must have one entry per robot ({n_robots}), got {len(paths)}")
-        for i, p in enumerate(paths):
-            if p is None or np.asarray(p).size == 0:
-                path_list.append(None)
-                continue
-            cells = _as_cells(p, f"paths[{i}]")
-            _check_in_bounds(cells, f"paths[{i}]", shape)
-            path_list.append(cells)
+    if paths is None:
+        return path_list
+    if len(paths) != n_robots:
+        raise ValueError(f"paths must have one entry per robot ({n_robots}), got {len(paths)}")
+    for i, p in enumerate(paths):
+        if p is None or np.asarray(p).size == 0:
+            path_list.append(None)
+            continue
+        cells = _as_cells(p, f"paths[{i}]")
+        _check_in_bounds(cells, f"paths[{i}]", shape)
+        path_list.append(cells)
+    return path_list
 
-    tgt: np.ndarray | None = None
-    if targets is not None:
-        tgt = _as_cells(targets, "targets", n=n_robots)
-        valid = np.all(tgt >= 0, axis=1)
-        _check_in_bounds(tgt[valid], "targets", shape)
 
-    # -- per-cell colours ------------------------------------------------------------------
+def _check_targets(targets: np.ndarray, n_robots: int, shape: tuple[int, int]) -> np.ndarray:
+    tgt = _as_cells(targets, "targets", n=n_robots)
+    valid = np.all(tgt >= 0, axis=1)
+    _check_in_bounds(tgt[valid], "targets", shape)
+    return tgt
+
+
+def _panels(
+    true_grid: np.ndarray, belief: np.ndarray, labels: np.ndarray | None, cell_px: int
+) -> np.ndarray:
+    """The frame's two panels (true grid | gap | belief with frontier tints), no overlays."""
+    h, w = true_grid.shape
     true_rgb = np.where(np.asarray(true_grid, dtype=bool)[..., None], COLOR_OCCUPIED, COLOR_FREE)
     b = np.asarray(belief)
     belief_rgb = np.empty((h, w, 3), dtype=np.uint8)
@@ -292,60 +256,84 @@ def render_rgb(
         if np.any(fmask):
             belief_rgb[fmask] = CLUSTER_PALETTE[(labels[fmask] - 1) % len(CLUSTER_PALETTE)]
 
-    true_panel = _upscale(true_rgb.astype(np.uint8, copy=False), cell_px)
-    belief_panel = _upscale(belief_rgb, cell_px)
-    _grid_lines(true_panel, cell_px)
-    _grid_lines(belief_panel, cell_px)
+    true_panel = upscale(true_rgb.astype(np.uint8, copy=False), cell_px)
+    belief_panel = upscale(belief_rgb, cell_px)
+    grid_lines(true_panel, cell_px)
+    grid_lines(belief_panel, cell_px)
 
-    frame = np.empty(frame_shape(shape, cell_px), dtype=np.uint8)
+    frame = np.empty(frame_shape((int(h), int(w)), cell_px), dtype=np.uint8)
     pw = w * cell_px
     frame[:, :pw] = true_panel
     frame[:, pw : pw + cell_px] = COLOR_GAP
     frame[:, pw + cell_px :] = belief_panel
-    offsets = (0, pw + cell_px)  # column offset of each panel in pixels
+    return frame
 
-    # -- overlays --------------------------------------------------------------------------
-    if cents is not None and len(cents):
-        r_dot = max(0.22 * cell_px, 0.5)
-        r_out = r_dot + max(1.0, cell_px / 12.0)
-        x0 = offsets[1]
-        for k, c in enumerate(cents):
-            if not np.all(np.isfinite(c)):
-                continue
-            cy, cx = _cell_center_px(c, cell_px)
-            color = CLUSTER_PALETTE[k % len(CLUSTER_PALETTE)]
-            if cell_px >= 4:
-                _fill_disc(frame, cy, cx + x0, r_out, COLOR_OUTLINE, x0, x0 + pw)
-            _fill_disc(frame, cy, cx + x0, r_dot, color, x0, x0 + pw)
 
-    robot_colors = ROBOT_PALETTE[np.arange(n_robots) % len(ROBOT_PALETTE)]
-    if tgt is not None:
-        thick = max(1, cell_px // 6)
-        for i in range(n_robots):
-            if np.any(tgt[i] < 0):
-                continue
-            for off in offsets:
-                _draw_hollow_square(
-                    frame, tgt[i, 0], tgt[i, 1], cell_px, thick, robot_colors[i], off
-                )
+def _draw_centroids(frame: np.ndarray, cents: np.ndarray, cell_px: int, x0: int, pw: int) -> None:
+    """Cluster centroids as outlined dots on the belief panel (NaN rows skipped)."""
+    r_dot = max(0.22 * cell_px, 0.5)
+    r_out = r_dot + max(1.0, cell_px / 12.0)
+    for k, c in enumerate(cents):
+        if not np.all(np.isfinite(c)):
+            continue
+        cy, cx = cell_center_px(c, cell_px)
+        color = CLUSTER_PALETTE[k % len(CLUSTER_PALETTE)]
+        if cell_px >= 4:
+            fill_disc(frame, cy, cx + x0, r_out, COLOR_OUTLINE, x0, x0 + pw)
+        fill_disc(frame, cy, cx + x0, r_dot, color, x0, x0 + pw)
 
+
+def _draw_targets(
+    frame: np.ndarray,
+    tgt: np.ndarray,
+    robot_colors: np.ndarray,
+    cell_px: int,
+    offsets: tuple[int, int],
+) -> None:
+    """Each robot's target as a hollow square in its colour on both panels."""
+    thick = max(1, cell_px // 6)
+    for i in range(len(tgt)):
+        if np.any(tgt[i] < 0):
+            continue
+        for off in offsets:
+            draw_hollow_square(frame, tgt[i, 0], tgt[i, 1], cell_px, thick, robot_colors[i], off)
+
+
+def _draw_paths(
+    frame: np.ndarray,
+    path_list: list[np.ndarray | None],
+    robot_colors: np.ndarray,
+    cell_px: int,
+    offsets: tuple[int, int],
+    pw: int,
+) -> None:
+    """The cells each robot walked in the last step, as lines through cell centres."""
     width = max(1, cell_px // 6)
     for i, cells in enumerate(path_list):
         if cells is None:
             continue
-        pts = _cell_center_px(cells, cell_px)
+        pts = cell_center_px(cells, cell_px)
         for off in offsets:
-            _draw_polyline(frame, pts + [0.0, off], width, robot_colors[i], off, off + pw)
+            draw_polyline(frame, pts + [0.0, off], width, robot_colors[i], off, off + pw)
 
+
+def _draw_robots(
+    frame: np.ndarray,
+    positions: np.ndarray,
+    robot_colors: np.ndarray,
+    cell_px: int,
+    offsets: tuple[int, int],
+    pw: int,
+) -> None:
+    """Robots as outlined discs in their colours on both panels."""
     r_robot = max(0.38 * cell_px, 0.5)
     r_robot_out = r_robot + max(1.0, cell_px / 12.0)
-    for i in range(n_robots):
-        cy, cx = _cell_center_px(positions[i], cell_px)
+    for i in range(len(positions)):
+        cy, cx = cell_center_px(positions[i], cell_px)
         for off in offsets:
-            if cell_px >= _GRID_LINE_MIN_PX:
-                _fill_disc(frame, cy, cx + off, r_robot_out, COLOR_OUTLINE, off, off + pw)
-            _fill_disc(frame, cy, cx + off, r_robot, robot_colors[i], off, off + pw)
-    return frame
+            if cell_px >= GRID_LINE_MIN_PX:
+                fill_disc(frame, cy, cx + off, r_robot_out, COLOR_OUTLINE, off, off + pw)
+            fill_disc(frame, cy, cx + off, r_robot, robot_colors[i], off, off + pw)
 
 
 def render_ansi(
