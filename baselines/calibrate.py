@@ -7,6 +7,8 @@ setting by how well the two heuristics reproduce those figures::
 
     python baselines/calibrate.py                      # the full search (about 6 min, one core)
     python baselines/calibrate.py --quick              # smoke test (seconds)
+    python baselines/calibrate.py --protocol --out calibration-protocol.json
+                                                       # greedy distance as in Table 6.5
 
 Every setting is evaluated with :func:`frontier_marl.evaluation.evaluate` (episode ``i`` uses
 reset seed ``seed + i``) on the static map drawn from ``--map-seed`` (fixed, never searched),
@@ -41,6 +43,11 @@ Stages:
    of its score on the calibration seeds and its score on the held-out seeds.
 4. **checks of the winner** (reported, never used to choose): other static map seeds, the
    dynamic map, and Reward 1.
+
+The heuristics are the plain rules (re-decide every step), as the calibration was run;
+``--protocol`` gives them the options of the thesis protocol of ``frontier-marl baselines``
+(:data:`frontier_marl.workflows.baselines.THESIS_PROTOCOL`: greedy distance keeps its target
+after a step that turned back without seeing anything new), recorded as ``policy_options``.
 
 Writes ``--out`` (JSON: every evaluated setting with its figures and CPU time, the stages,
 the winner and its checks) and prints a summary.
@@ -162,8 +169,16 @@ def fits(row: dict[str, Any], tolerance: float) -> bool:
 class Evaluator:
     """Evaluates settings (both heuristics), caching by setting and counting CPU time."""
 
-    def __init__(self, episodes: int, seed: int, map_seed: int, reward: str) -> None:
+    def __init__(
+        self,
+        episodes: int,
+        seed: int,
+        map_seed: int,
+        reward: str,
+        options: dict[str, dict[str, Any]] | None = None,
+    ) -> None:
         self.episodes, self.seed, self.map_seed, self.reward = episodes, seed, map_seed, reward
+        self.options = options or {}  # policy name -> make_policy options
         self.cache: dict[str, dict[str, Any]] = {}
         self.cpu_seconds = 0.0
 
@@ -191,7 +206,8 @@ class Evaluator:
             row["variant"] = {**extra, "seed": seed}
         kwargs = self.env_kwargs(setting, **extra)
         for name in POLICIES:
-            result = evaluate(kwargs, make_policy(name), episodes=self.episodes, seed=seed)
+            policy = make_policy(name, **self.options.get(name, {}))
+            result = evaluate(kwargs, policy, episodes=self.episodes, seed=seed)
             row[name] = {
                 "mean": round(result.mean_reward, 4),
                 "std": round(result.std_reward, 4),
@@ -321,6 +337,11 @@ def main(argv: list[str] | None = None) -> int:
         "or calibration-quick.json with --quick)",
     )
     parser.add_argument("--quick", action="store_true", help="tiny search, 3 episodes")
+    parser.add_argument(
+        "--protocol",
+        action="store_true",
+        help="the heuristics take the thesis protocol's options (THESIS_PROTOCOL)",
+    )
     args = parser.parse_args(argv)
     if args.quick:
         args.episodes = min(args.episodes, 3)
@@ -335,12 +356,19 @@ def main(argv: list[str] | None = None) -> int:
         print(text, flush=True)
 
     wall = time.perf_counter()
-    ev = Evaluator(args.episodes, args.seed, args.map_seed, args.reward)
+    options = {}
+    if args.protocol:
+        from frontier_marl.workflows.baselines import THESIS_PROTOCOL
+
+        options = {n: dict(THESIS_PROTOCOL[n]) for n in POLICIES if n in THESIS_PROTOCOL}
+    ev = Evaluator(args.episodes, args.seed, args.map_seed, args.reward, options)
     log(
         f"calibrating against GD {THESIS['greedy-distance']} and GG {THESIS['greedy-gain']}: "
         f"{args.episodes} episodes, seed {args.seed}, static map seed {args.map_seed}, "
         f"{args.reward}"
     )
+    if options:
+        log(f"heuristic options: {options}")
     reference = ev.run(dict(REFERENCE), stage="reference")
     log(f"reference: {_summary(reference)}")
 
@@ -429,6 +457,7 @@ def main(argv: list[str] | None = None) -> int:
         "check_seed": args.check_seed,
         "map_seed": args.map_seed,
         "reward": args.reward,
+        **({"policy_options": options} if options else {}),
         "fixed": FIXED,
         "reference": REFERENCE,
         "coarse_space": coarse,
