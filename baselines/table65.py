@@ -9,9 +9,11 @@ maps), for each candidate choice (docs/calibration.md, "Table 6.5"). For each ca
 reports the eight cells; whether the thesis's four known cells (``frontier_marl.thesis.
 HEURISTIC_BASELINES``) are within one thesis std; how far the four cells the thesis's figures
 are not known for moved from the current default; the two calibration rows (20x20 static),
-and exactly unchanged or not; and the thesis's two qualitative claims: (a) greedy distance
+and exactly unchanged or not; the thesis's two qualitative claims: (a) greedy distance
 ahead of greedy gain in all four settings, (b) on both grids, for both heuristics, dynamic
-maps give a lower mean and a wider spread than the static map.
+maps give a lower mean and a wider spread than the static map; and which episodes it
+changed from the default (and whether the default had reached the threshold in them).
+``--episodes 300`` gives the stuck episodes (300 minus the terminations) of each rule.
 
 Some candidates are variants of greedy distance that the package does not offer (another
 distance, a tolerance for ties, a commitment triggered by Reward 2's oscillation test): they
@@ -230,10 +232,19 @@ def env_kwargs(candidate: Candidate, preset: str, mode: str) -> dict[str, Any]:
     return kwargs
 
 
-def measure(
-    candidate: Candidate, episodes: int, cache: dict[str, tuple[float, float, list[float]]]
-) -> dict[str, tuple[float, float, list[float]]]:
-    """(mean, std, per-episode rewards) of each of the eight cells, ``"preset mode policy"``."""
+@dataclass
+class Cell:
+    """One heuristic on one setting: mean and std of the total reward (rounded to 0.01),
+    terminations, and each episode's (reward, end reason, steps, cells travelled)."""
+
+    mean: float
+    std: float
+    terminations: int
+    episodes: list[tuple[float, str, int, int]]
+
+
+def measure(candidate: Candidate, episodes: int, cache: dict[str, Cell]) -> dict[str, Cell]:
+    """Each of the eight cells, by ``"preset mode policy"``."""
     cells = {}
     for preset, mode in SETTINGS:
         kwargs = env_kwargs(candidate, preset, mode)
@@ -244,43 +255,48 @@ def measure(
             memo = json.dumps([kwargs, policy, key], sort_keys=True)
             if memo not in cache:
                 result = evaluate(kwargs, factory(), episodes)
-                cache[memo] = (
+                cache[memo] = Cell(
                     round(result.mean_reward, 2),
                     round(result.std_reward, 2),
-                    [e.reward for e in result.episodes],
+                    result.terminations,
+                    [(e.reward, e.end_reason, e.steps, e.travelled) for e in result.episodes],
                 )
             cells[f"{preset} {mode} {policy}"] = cache[memo]
     return cells
 
 
-def checks(
-    cells: dict[str, tuple[float, float, list[float]]],
-    default: dict[str, tuple[float, float, list[float]]],
-) -> dict[str, Any]:
-    """The criteria of the task for one candidate's cells."""
+def checks(cells: dict[str, Cell], default: dict[str, Cell]) -> dict[str, Any]:
+    """The criteria of the task for one candidate's cells, and which episodes it changed."""
     known = {}
     for (preset, mode, policy), (mean, std) in HEURISTIC_BASELINES.items():
-        ours = cells[f"{preset} {mode} {policy}"][0]
+        ours = cells[f"{preset} {mode} {policy}"].mean
         known[f"{preset} {mode} {policy}"] = abs(ours - mean) <= std
     moved = {
-        key: round(cells[key][0] - default[key][0], 2)
+        key: round(cells[key].mean - default[key].mean, 2)
         for key in cells
         if tuple(key.split()) not in HEURISTIC_BASELINES
     }
     ahead = all(
-        cells[f"{p} {m} greedy-distance"][0] > cells[f"{p} {m} greedy-gain"][0] for p, m in SETTINGS
+        cells[f"{p} {m} greedy-distance"].mean > cells[f"{p} {m} greedy-gain"].mean
+        for p, m in SETTINGS
     )
     dynamic = all(
-        cells[f"{p} dynamic {h}"][0] < cells[f"{p} static {h}"][0]
-        and cells[f"{p} dynamic {h}"][1] > cells[f"{p} static {h}"][1]
+        cells[f"{p} dynamic {h}"].mean < cells[f"{p} static {h}"].mean
+        and cells[f"{p} dynamic {h}"].std > cells[f"{p} static {h}"].std
         for p in ("thesis-20x20", "thesis-30x30")
         for h in HEURISTICS
     )
     calibration = {
-        h: cells[f"{CALIBRATION[0]} {CALIBRATION[1]} {h}"][2]
-        == default[f"{CALIBRATION[0]} {CALIBRATION[1]} {h}"][2]
+        h: cells[f"{CALIBRATION[0]} {CALIBRATION[1]} {h}"].episodes
+        == default[f"{CALIBRATION[0]} {CALIBRATION[1]} {h}"].episodes
         for h in HEURISTICS
     }
+    changed = {}  # cell -> [episodes changed, of which the default ended at the threshold]
+    for key, cell in cells.items():
+        pairs = list(zip(cell.episodes, default[key].episodes, strict=True))
+        differ = [old for new, old in pairs if new != old]
+        if differ:
+            changed[key] = [len(differ), sum(old[1] == "threshold" for old in differ)]
     return {
         "known_within": known,
         "unknown_moved": moved,
@@ -288,6 +304,7 @@ def checks(
         "dynamic_lower_and_wider": dynamic,
         "calibration_rows_identical": calibration,
         "all": all(known.values()) and ahead and dynamic and all(calibration.values()),
+        "changed_episodes": changed,
     }
 
 
@@ -301,7 +318,7 @@ def main(argv: list[str] | None = None) -> int:
     unknown = sorted(set(names) - set(CANDIDATES))
     if unknown:
         parser.error(f"unknown candidate(s) {unknown}; known: {', '.join(CANDIDATES)}")
-    cache: dict[str, tuple[float, float, list[float]]] = {}
+    cache: dict[str, Cell] = {}
     default = measure(CANDIDATES["default"], args.episodes, cache)
     report = []
     for name in names:
@@ -312,21 +329,26 @@ def main(argv: list[str] | None = None) -> int:
             {
                 "candidate": name,
                 "note": candidate.note,
-                "cells": {k: [m, s] for k, (m, s, _) in cells.items()},
+                "episodes": args.episodes,
+                "cells": {k: [c.mean, c.std, c.terminations] for k, c in cells.items()},
                 **verdict,
             }
         )
         print(f"\n{name}: {candidate.note}")
         for preset, mode in SETTINGS:
             row = "   ".join(
-                f"{h.split('-')[1]} {cells[f'{preset} {mode} {h}'][0]:6.2f} ± "
-                f"{cells[f'{preset} {mode} {h}'][1]:.2f}"
+                f"{h.split('-')[1]} {c.mean:6.2f} ± {c.std:.2f} ({c.terminations:3d} term.)"
                 for h in HEURISTICS
+                for c in [cells[f"{preset} {mode} {h}"]]
             )
             print(f"  {preset} {mode:7s}  {row}")
         within = sum(verdict["known_within"].values())
         moved = ", ".join(
             f"{k.replace('thesis-', '')} {v:+.2f}" for k, v in verdict["unknown_moved"].items()
+        )
+        changed = ", ".join(
+            f"{k.replace('thesis-', '')} {n} ({finished} had reached the threshold)"
+            for k, (n, finished) in verdict["changed_episodes"].items()
         )
         print(
             f"  known cells within one thesis std: {within}/{len(verdict['known_within'])}; "
@@ -335,6 +357,7 @@ def main(argv: list[str] | None = None) -> int:
             f"calibration rows identical: {verdict['calibration_rows_identical']}"
         )
         print(f"  unknown cells moved: {moved}")
+        print(f"  episodes changed from the default: {changed or 'none'}")
         print(f"  every criterion: {verdict['all']}")
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=1) + "\n")

@@ -45,5 +45,10 @@ def test_table65_reports_each_candidate_against_the_criteria(tmp_path: Path) -> 
     assert len(adopted["unknown_moved"]) == 4
     assert set(default["unknown_moved"].values()) == {0.0}  # the reference of the moves
     assert default["calibration_rows_identical"] == {"greedy-distance": True, "greedy-gain": True}
+    assert default["changed_episodes"] == {}
     for row in (default, adopted):
         assert isinstance(row["all"], bool) and isinstance(row["gd_ahead_everywhere"], bool)
+        for _mean, std, terminations in row["cells"].values():
+            assert std >= 0 and 0 <= terminations <= 2
+        for changed, finished in row["changed_episodes"].values():
+            assert 0 <= finished <= changed <= 2
