@@ -49,3 +49,11 @@ def test_quick_run_writes_a_complete_results_file(tmp_path):
             assert r[policy]["std"] >= 0 and 0 <= r[policy]["terminations"] <= data["episodes"]
     assert data["episodes"] == 3 and data["map_seed"] == 0
     assert {"reward1", "dynamic map"} <= set(data["checks"])
+    assert "policy_options" not in data  # the plain rules unless --protocol
+
+
+def test_protocol_gives_greedy_distance_the_thesis_protocol_options(tmp_path):
+    out = tmp_path / "calibration.json"
+    assert main(["--quick", "--protocol", "--out", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["policy_options"] == {"greedy-distance": {"commit": "on-cycle"}}

@@ -90,6 +90,27 @@ def test_thesis_figures_appear_beside_ours(capsys):
     assert "16.48 ± 1.78" in printed and "15.01 ± 1.12" in printed
 
 
+def test_the_thesis_protocol_applies_on_the_thesis_presets_only(tmp_path, capsys):
+    # thesis-30x30, static, seed 16: plain greedy distance cycles between two clusters (37 %
+    # coverage, tests/test_policies.py); the thesis protocol's (commit on-cycle) does not
+    out_json = tmp_path / "rows.json"
+    argv = ["baselines", "--episodes", "1", "--seed", "16", "--no-progress"]
+    thesis = [*argv, "--preset", "thesis-30x30", "--policies", "greedy-distance"]
+    assert main([*thesis, "--json", str(out_json)]) == 0
+    (row,) = json.loads(out_json.read_text())
+    assert row["end_reasons"] == {"threshold": 1}
+    assert "36.39 ± 1.27" in capsys.readouterr().out  # the thesis's Table 6.5 figure
+    # a loaded map is not the thesis's setting: greedy distance is the plain rule there
+    from tests.test_policies import CYCLE_MAP
+
+    path = tmp_path / "cycle.txt"
+    path.write_text(CYCLE_MAP)
+    loaded = ["baselines", "--episodes", "1", "--seed", "0", "--no-progress", "--map", str(path)]
+    assert main([*loaded, "--policies", "greedy-distance", "--json", str(out_json)]) == 0
+    (row,) = json.loads(out_json.read_text())
+    assert row["end_reasons"] == {"no_progress": 1}
+
+
 def test_team_and_dynamic_options(tmp_path):
     out_json = tmp_path / "team.json"
     code = main(

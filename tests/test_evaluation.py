@@ -201,8 +201,12 @@ def test_invalid_arguments(kwargs, match):
 def test_thesis_figures():
     assert heuristic_baseline("thesis-20x20", "static", "greedy-distance") == (16.48, 1.78)
     assert heuristic_baseline("thesis-20x20", "static", "greedy-gain") == (15.01, 1.12)
+    # the thesis's Table 6.5 as quoted in issue 31: greedy distance on 30 x 30 only
+    assert heuristic_baseline("thesis-30x30", "static", "greedy-distance") == (36.39, 1.27)
+    assert heuristic_baseline("thesis-30x30", "dynamic", "greedy-distance") == (35.15, 3.57)
     assert heuristic_baseline("thesis-30x30", "static", "greedy-gain") is None
-    assert len(HEURISTIC_BASELINES) == 2
+    assert heuristic_baseline("thesis-20x20", "dynamic", "greedy-distance") is None
+    assert len(HEURISTIC_BASELINES) == 4
 
 
 # ----------------------------------------------------------------- metrics

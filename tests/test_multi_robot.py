@@ -757,3 +757,40 @@ def test_team_commit_keeps_each_robot_on_its_target_after_a_step_without_progres
         progressed = {a: {**i, "new_cells": 1} for a, i in infos.items()}
         fresh = make_policy(name, **kwargs).act_team(obs, progressed)
         assert policy.act_team(obs, progressed) == fresh, name
+
+
+def test_team_commit_on_cycle_keeps_the_target_of_a_robot_back_on_a_cell():
+    # Robot 0 heads for A (col 8) from (0, 3), steps to (0, 2) and back to (0, 3) while no
+    # robot sees anything new: it is cycling and keeps A; robot 1 moves on and is decided
+    # with the team. Once a robot sees a new cell, both are decided afresh.
+    belief = np.full((1, 9), FREE, np.int8)
+    clusters = [(0, (0, 0)), (1, (0, 8))]
+
+    def infos_at(step, cell_0, cell_1, new_cells=0):
+        return {
+            "robot_0": {
+                **free_info(clusters, cell_0, belief),
+                "target": (0, 8) if step else None,
+                "new_cells": new_cells,
+                "step": step,
+            },
+            "robot_1": {
+                **free_info(clusters, cell_1, belief),
+                "target": None,
+                "new_cells": 0,
+                "step": step,
+            },
+        }
+
+    walk = [infos_at(0, (0, 3), (0, 4)), infos_at(1, (0, 2), (0, 5)), infos_at(2, (0, 3), (0, 6))]
+    obs = dict.fromkeys(walk[0])
+    for name in TEAM_POLICIES:
+        kwargs = {"sensor_range": 2} if name == "utility-discount" else {}
+        policy = make_policy(name, commit="on-cycle", **kwargs)
+        for infos in walk[:2]:
+            assert policy.act_team(obs, infos) == make_policy(name, **kwargs).act_team(obs, infos)
+        assert make_policy(name, **kwargs).act_team(obs, walk[2])["robot_0"] == 0, name
+        assert policy.act_team(obs, walk[2])["robot_0"] == 1, name  # keeps A
+        progressed = infos_at(3, (0, 3), (0, 6), new_cells=2)
+        fresh = make_policy(name, **kwargs).act_team(obs, progressed)
+        assert policy.act_team(obs, progressed) == fresh, name

@@ -227,6 +227,74 @@ def test_commit_keeps_the_previous_target_while_nothing_new_was_seen() -> None:
     assert policy.act(None, {**stuck, "target": None}) == 1  # no previous target
 
 
+def test_commit_on_cycle_keeps_the_target_once_a_cell_repeats_without_progress():
+    # two clusters; the robot walks (0, 3) -> (0, 4) -> (0, 3) seeing nothing new, the
+    # nearest centroid flipping at each cell: at its second stand on (0, 3) it is in a cycle
+    toward_a = [live_slot(1, 2.0, target=(0, 1)), live_slot(1, 1.0, target=(0, 2))]
+    toward_b = [live_slot(1, 1.0, target=(0, 1)), live_slot(1, 2.0, target=(0, 2))]
+    steps = [
+        info_with(toward_a, step=0, position=(0, 3), target=None, new_cells=0),
+        info_with(toward_b, step=1, position=(0, 4), target=(0, 2), new_cells=0),
+        info_with(toward_a, step=2, position=(0, 3), target=(0, 1), new_cells=0),
+        info_with(toward_b, step=3, position=(0, 4), target=(0, 1), new_cells=0),
+        info_with(toward_a, step=4, position=(0, 5), target=(0, 1), new_cells=4),
+    ]
+    plain = [GreedyDistance().act(None, info) for info in steps]
+    assert plain == [1, 0, 1, 0, 1]
+    policy = GreedyDistance(commit="on-cycle")
+    # steps 2 and 3: cycling, keeps (0, 1) (slot 0); step 4 saw something: decides afresh
+    assert [policy.act(None, info) for info in steps] == [1, 0, 0, 0, 1]
+    # a new episode (step 0) forgets the cells; so does reset()
+    assert [policy.act(None, info) for info in steps[:3]] == [1, 0, 0]
+    policy.reset()
+    assert policy.act(None, steps[2]) == 1
+    # a kept target no longer offered: the nearest centroid, as without the rule
+    assert policy.act(None, {**steps[2], "step": 5, "target": (7, 7)}) == 1
+    gain = make_policy("greedy-gain", commit="on-cycle")
+    assert gain.commit == "on-cycle"
+    team = {"robot_0": steps[0], "robot_1": {**steps[0], "position": (0, 9)}}
+    chosen = make_policy("greedy-distance", commit="on-cycle").act_team(dict.fromkeys(team), team)
+    assert chosen == {"robot_0": 1, "robot_1": 1}
+
+
+#: A hand-made 8 x 8 map (``#`` obstacle) on which greedy distance, started from reset seed 0
+#: at (6, 7) with the thesis-20x20 defaults (r = 3), ends up turning back and forth between
+#: (6, 5) and (5, 5): one cell toward the target (3, 5) makes the centroid of the cluster at
+#: (6, 3) the nearer one, and one cell toward that makes the first nearer again.
+CYCLE_MAP = """\
+......#.
+........
+.......#
+#.......
+#....#..
+......#.
+....#...
+........
+"""
+
+
+@pytest.mark.parametrize("commit", ["none", "on-cycle"])
+def test_a_greedy_distance_cycle_on_a_tiny_map_and_the_on_cycle_rule(tmp_path, commit):
+    """Re-deciding every step, greedy distance cycles between two cells with the map 44 %
+    known until the no-progress rule ends the episode; keeping its target once it stands on
+    a cell again without having seen anything new, it reaches the threshold."""
+    path = tmp_path / "cycle.txt"
+    path.write_text(CYCLE_MAP)
+    env = frontier_marl.parallel_env(preset="thesis-20x20", map_path=str(path))
+    policy = make_policy("greedy-distance", commit=commit)
+    observations, infos = env.reset(seed=0)
+    cells = []
+    while env.agents:
+        cells.append(infos["robot_0"]["position"])
+        observations, _, _, _, infos = env.step(policy.act_team(observations, infos))
+    end = infos["robot_0"]
+    if commit == "none":
+        assert end["end_reason"] == "no_progress" and end["coverage"] < 0.5
+        assert set(cells[-20:]) == {(6, 5), (5, 5)}  # the last 20 steps: two cells
+    else:
+        assert end["end_reason"] == "threshold"
+
+
 def test_policy_options_are_checked() -> None:
     assert make_policy("greedy-gain", commit="until-progress").commit == "until-progress"
     assert make_policy("coordinated-assignment", commit="until-progress").commit == "until-progress"
@@ -236,11 +304,12 @@ def test_policy_options_are_checked() -> None:
         make_policy("greedy-distance", beta=2.0)
 
 
-@pytest.mark.parametrize("commit", ["none", "until-progress"])
+@pytest.mark.parametrize("commit", ["none", "until-progress", "on-cycle"])
 def test_the_thesis_30x30_livelock_and_its_fix(commit: str) -> None:
     """Greedy distance on thesis-30x30, static, seed 16: turning back and forth between two
     clusters ends the episode by the no-progress rule at 37 % coverage; committing to the
-    target until something new is seen reaches the threshold."""
+    target until something new is seen, or only once a cell repeats without anything new
+    seen (``on-cycle``), reaches the threshold."""
     from frontier_marl.evaluation import evaluate
 
     result = evaluate(

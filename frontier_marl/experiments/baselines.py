@@ -22,6 +22,15 @@ from frontier_marl.utils.progress import progress_bar
 
 DEFAULT_POLICIES = "greedy-distance,greedy-gain,cost-utility,random"
 
+#: The thesis's baseline protocol (its Table 6.5: one robot on a ``thesis-*`` preset's
+#: geometry): the options each heuristic runs with there. Greedy distance (nearest centroid)
+#: re-decides every step, except once it stands again on a cell without having seen anything
+#: new since it stood there: it would then cycle between two clusters until the no-progress
+#: rule ends the episode, so it keeps its target until it sees something (``commit``
+#: ``on-cycle``; docs/calibration.md, "Table 6.5"). Elsewhere, and through ``make_policy``
+#: alone, the heuristics keep their own defaults.
+THESIS_PROTOCOL: dict[str, dict[str, Any]] = {"greedy-distance": {"commit": "on-cycle"}}
+
 
 def run_baselines(
     env_kwargs: dict[str, Any],
@@ -30,7 +39,12 @@ def run_baselines(
     seed: int,
     progress: bool = True,
 ) -> list[dict[str, Any]]:
-    """Evaluate each heuristic; one JSON-able row per policy (see ``EvaluationResult``)."""
+    """Evaluate each heuristic; one JSON-able row per policy (see ``EvaluationResult``).
+
+    Where the run is the thesis's setting (one robot, a ``thesis-*`` preset's geometry, its
+    map generator), the thesis's figure is put beside each row and the heuristics take the
+    options of :data:`THESIS_PROTOCOL`.
+    """
     cfg = make_config(**env_kwargs)
     preset = str(env_kwargs.get("preset", "thesis-20x20"))
     # The thesis's figures are shown for its geometry (size, range) with one robot only.
@@ -42,13 +56,15 @@ def run_baselines(
         and (cfg.height, cfg.width, cfg.perception_range)
         == (base.height, base.width, base.perception_range)
     )
+    protocol = comparable and preset.startswith("thesis-")
     rows = []
     with progress_bar(episodes * len(policies), disable=not progress, unit="ep") as bar:
         for name in policies:
             bar.set_description(name)
+            options = THESIS_PROTOCOL.get(name, {}) if protocol else {}
             result = evaluate(
                 dict(env_kwargs),
-                make_policy(name, seed),
+                make_policy(name, seed, **options),
                 episodes=episodes,
                 seed=seed,
                 on_episode=lambda _i, _rec: bar.update(1),

@@ -7,6 +7,8 @@ setting by how well the two heuristics reproduce those figures::
 
     python baselines/calibrate.py                      # the full search (about 6 min, one core)
     python baselines/calibrate.py --quick              # smoke test (seconds)
+    python baselines/calibrate.py --protocol --out calibration-protocol.json
+                                                       # greedy distance as in Table 6.5
 
 Every setting is evaluated with :func:`frontier_marl.evaluation.evaluate` (episode ``i`` uses
 reset seed ``seed + i``) on the static map drawn from ``--map-seed`` (fixed, never searched),
@@ -42,6 +44,11 @@ Stages:
 4. **checks of the winner** (reported, never used to choose): other static map seeds, the
    dynamic map, and Reward 1.
 
+The heuristics are the plain rules (re-decide every step), as the calibration was run;
+``--protocol`` gives them the options of the thesis protocol of ``frontier-marl baselines``
+(:data:`frontier_marl.experiments.baselines.THESIS_PROTOCOL`: greedy distance keeps its target
+once it is caught in a cycle), recorded as ``policy_options``.
+
 Writes ``--out`` (JSON: every evaluated setting with its figures and CPU time, the stages,
 the winner and its checks) and prints a summary.
 """
@@ -55,9 +62,11 @@ import time
 from pathlib import Path
 from typing import Any
 
+from frontier_marl.experiments.baselines import THESIS_PROTOCOL
 from frontier_marl.experiments.calibration_search import (
     FIXED,
     ORDER_PENALTY,
+    POLICIES,
     SLOTS_PENALTY,
     STD_WEIGHT,
     THESIS,
@@ -145,6 +154,11 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
         "or calibration-quick.json with --quick)",
     )
     parser.add_argument("--quick", action="store_true", help="tiny search, 3 episodes")
+    parser.add_argument(
+        "--protocol",
+        action="store_true",
+        help="the heuristics take the thesis protocol's options (THESIS_PROTOCOL)",
+    )
     args = parser.parse_args(argv)
     if args.quick:
         args.episodes = min(args.episodes, 3)
@@ -159,13 +173,18 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
         print(text, flush=True)
 
     wall = time.perf_counter()
-    ev = Evaluator(args.episodes, args.seed, args.map_seed, args.reward)
+    options = {}
+    if args.protocol:
+        options = {n: dict(THESIS_PROTOCOL[n]) for n in POLICIES if n in THESIS_PROTOCOL}
+    ev = Evaluator(args.episodes, args.seed, args.map_seed, args.reward, options)
     log(
         f"calibrating against GD {THESIS['greedy-distance']} and GG {THESIS['greedy-gain']}: "
         f"{args.episodes} episodes, seed {args.seed}, static map seed {args.map_seed}, "
         f"{args.reward}"
     )
     reference = ev.run(dict(REFERENCE), stage="reference")
+    if options:
+        log(f"heuristic options: {options}")
     log(f"reference: {summary_line(reference)}")
 
     # Stage 1 ------------------------------------------------------------------------------
@@ -253,6 +272,7 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
         "check_seed": args.check_seed,
         "map_seed": args.map_seed,
         "reward": args.reward,
+        **({"policy_options": options} if options else {}),
         "fixed": FIXED,
         "reference": REFERENCE,
         "coarse_space": coarse,

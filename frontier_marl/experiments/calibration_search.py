@@ -70,8 +70,16 @@ def fits(row: dict[str, Any], tolerance: float) -> bool:
 class Evaluator:
     """Evaluates settings (both heuristics), caching by setting and counting CPU time."""
 
-    def __init__(self, episodes: int, seed: int, map_seed: int, reward: str) -> None:
+    def __init__(
+        self,
+        episodes: int,
+        seed: int,
+        map_seed: int,
+        reward: str,
+        options: dict[str, dict[str, Any]] | None = None,
+    ) -> None:
         self.episodes, self.seed, self.map_seed, self.reward = episodes, seed, map_seed, reward
+        self.options = options or {}  # policy name -> make_policy options
         self.cache: dict[str, dict[str, Any]] = {}
         self.cpu_seconds = 0.0
 
@@ -99,7 +107,8 @@ class Evaluator:
             row["variant"] = {**extra, "seed": seed}
         kwargs = self.env_kwargs(setting, **extra)
         for name in POLICIES:
-            result = evaluate(kwargs, make_policy(name), episodes=self.episodes, seed=seed)
+            policy = make_policy(name, **self.options.get(name, {}))
+            result = evaluate(kwargs, policy, episodes=self.episodes, seed=seed)
             row[name] = {
                 "mean": round(result.mean_reward, 4),
                 "std": round(result.std_reward, 4),

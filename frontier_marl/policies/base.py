@@ -62,9 +62,10 @@ class Policy:
 
 
 #: ``commit`` values of the heuristics: re-decide every step (the thesis's greedy rule), keep
-#: the previous target while the last step revealed no new cell, or keep it until it is
-#: reached or no longer offered (decide only on arrival).
-COMMIT_RULES: tuple[str, ...] = ("none", "until-progress", "until-reached")
+#: the previous target while the last step revealed no new cell, keep it until it is
+#: reached or no longer offered (decide only on arrival), or re-decide every step until the
+#: robot is caught in a cycle, then keep it until a new cell is seen.
+COMMIT_RULES: tuple[str, ...] = ("none", "until-progress", "until-reached", "on-cycle")
 
 
 def check_commit(commit: str) -> str:
@@ -83,17 +84,41 @@ class HeuristicPolicy(Policy):
             clusters have not changed, so the robot walks on instead of turning back and forth
             between two clusters (docs/calibration.md, "Livelocks"). ``until-reached`` keeps
             it whatever the step revealed, until it is reached or no longer offered.
+            ``on-cycle`` re-decides every step as ``none`` does until the robot stands again on
+            a cell it stood on since the last new cell was seen (:class:`CycleWatch`): from
+            there it would make the same choices again and turn in a cycle until the
+            no-progress rule ends the episode, so from then until a new cell is seen it keeps
+            its target (while offered). With a team, "a new cell" is one any robot revealed.
     """
 
     def __init__(self, commit: str = "none") -> None:
         self.commit = check_commit(commit)
+        self._watch = CycleWatch()
+
+    def reset(self, seed: int | None = None) -> None:
+        self._watch.clear()
 
     def act(self, obs: Any, info: Info) -> int:
+        if self.commit == "on-cycle":
+            kept = self._watch.kept(None, info, bool(info["new_cells"]))
+            return int(self.choose(info)) if kept is None else kept
         if self.commit != "none":
             kept = kept_slot(info, self.commit)
             if kept is not None:
                 return kept
         return int(self.choose(info))
+
+    def act_team(
+        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
+    ) -> dict[str, int]:
+        if self.commit != "on-cycle":
+            return super().act_team(observations, infos)
+        progressed = any(infos[agent]["new_cells"] for agent in observations)
+        chosen = {}
+        for agent in observations:
+            kept = self._watch.kept(agent, infos[agent], progressed)
+            chosen[agent] = int(self.choose(infos[agent])) if kept is None else kept
+        return chosen
 
     def choose(self, info: Info) -> int:
         raise NotImplementedError
@@ -105,6 +130,43 @@ def kept_slot(info: Info, commit: str = "until-progress") -> int | None:
     if commit == "until-progress" and info["new_cells"]:
         return None
     return previous_target_slot(info)
+
+
+class CycleWatch:
+    """Per robot: the cells it has stood on since the last new cell was seen, and whether it
+    has stood on one of them again since (the ``on-cycle`` commit rule).
+
+    A heuristic that decides from the slot table alone, standing again on a cell with the
+    belief unchanged, sees the slots it saw there and makes the same choice: one robot is then
+    in a cycle that only the no-progress rule ends (docs/calibration.md, "Table 6.5"). Robots
+    are told apart by a key (the agent name); a new episode (``info["step"] == 0``) or a step
+    that revealed a cell (``progressed``) clears the robot's record.
+    """
+
+    def __init__(self) -> None:
+        self._cells: dict[Any, set[tuple[int, int]]] = {}
+        self._cycling: set[Any] = set()
+
+    def clear(self) -> None:
+        self._cells.clear()
+        self._cycling.clear()
+
+    def cycling(self, key: Any, info: Info, progressed: bool) -> bool:
+        """Record the robot's cell; whether it has stood on a cell twice since progress."""
+        if progressed or info["step"] == 0:
+            self._cells.pop(key, None)
+            self._cycling.discard(key)
+        cells = self._cells.setdefault(key, set())
+        cell = (int(info["position"][0]), int(info["position"][1]))
+        if cell in cells:
+            self._cycling.add(key)
+        cells.add(cell)
+        return key in self._cycling
+
+    def kept(self, key: Any, info: Info, progressed: bool) -> int | None:
+        """The slot of the robot's previous target while it is cycling (and that target is
+        still offered), else ``None``."""
+        return previous_target_slot(info) if self.cycling(key, info, progressed) else None
 
 
 def previous_target_slot(info: Info) -> int | None:

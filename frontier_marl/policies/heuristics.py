@@ -21,7 +21,10 @@ state:
 
 Every heuristic but ``random`` takes ``commit`` (:class:`~frontier_marl.policies.base.
 HeuristicPolicy`): ``none`` re-decides at every step; ``until-progress`` keeps the previous
-target while the last step revealed nothing.
+target while the last step revealed nothing; ``on-cycle`` re-decides every step until the robot
+stands again on a cell without having seen anything new since it stood there, then keeps its
+target until it sees something (the thesis protocol's greedy distance,
+:data:`frontier_marl.experiments.baselines.THESIS_PROTOCOL`).
 """
 
 from __future__ import annotations

@@ -27,7 +27,9 @@ path lengths.
 
 Both take ``commit`` as the single-robot heuristics do: with ``until-progress``, after a step in
 which no robot revealed a cell, every robot whose previous target is still offered keeps it,
-and the others are decided jointly among the remaining clusters.
+and the others are decided jointly among the remaining clusters; with ``on-cycle``, every robot
+that stands again on a cell it stood on since any robot last revealed a cell keeps its target
+until one does.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from frontier_marl.policies.base import (
+    CycleWatch,
     Info,
     Policy,
     check_commit,
@@ -68,6 +71,10 @@ class TeamHeuristic(Policy):
     def __init__(self, commit: str = "none") -> None:
         self._config: Any = None
         self.commit = check_commit(commit)
+        self._watch = CycleWatch()
+
+    def reset(self, seed: int | None = None) -> None:
+        self._watch.clear()
 
     def attach(self, env: Any) -> None:
         self._config = getattr(getattr(env, "unwrapped", env), "config", None)
@@ -107,6 +114,12 @@ class TeamHeuristic(Policy):
             self.commit == "until-progress" and not any(info["new_cells"] for info in team)
         ):
             kept = [previous_target_slot(info) for info in team]
+        elif self.commit == "on-cycle":
+            progressed = any(info["new_cells"] for info in team)
+            kept = [
+                self._watch.kept(agent, info, progressed)
+                for agent, info in zip(agents, team, strict=True)
+            ]
         chosen = self._choose_around(options, kept)
         return {
             agent: (0 if pick is None else pick.slot)
