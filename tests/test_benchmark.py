@@ -87,6 +87,7 @@ def test_paired_difference_on_hand_computed_numbers():
     assert out["ci_high"] == pytest.approx(1 / 15 + half, abs=1e-5)
     assert paired_difference([5], [4]) == {
         "pairs": 1,
+        "undefined": 0,
         "mean": 0.25,
         "ci_low": None,
         "ci_high": None,
@@ -94,6 +95,39 @@ def test_paired_difference_on_hand_computed_numbers():
     assert paired_difference([None], [4])["mean"] is None
     with pytest.raises(ValueError, match="pair up"):
         paired_difference([1, 2], [1])
+
+
+def test_a_baseline_of_zero_leaves_the_difference_undefined_not_a_crash():
+    out = paired_difference([0, 3, 0], [0, 2, 0])  # T99 = 0: the map was seen whole at reset
+    assert (out["pairs"], out["undefined"], out["mean"]) == (1, 2, 0.5)
+    none = paired_difference([0, 0], [0, 0])
+    assert (none["pairs"], none["undefined"], none["mean"]) == (0, 2, None)
+    with pytest.raises(ValueError, match=">= 0"):
+        paired_difference([1], [-1])
+
+
+def test_a_map_seen_whole_at_reset_is_reported_and_written(tmp_path: Path) -> None:
+    seen = tmp_path / "open.txt"
+    seen.write_text("....\n....\n....\n")  # r = 3 sees every cell from anywhere
+    out = tmp_path / "open.json"
+    argv = ["benchmark", "--map", str(seen), "--episodes", "2", "--no-progress"]
+    assert main([*argv, "--policies", "nearest-path,cost-utility", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["success"] for row in rows] == [2, 2]
+    assert all(row["vs_best"]["undefined"] >= 1 for row in rows)
+    assert format_table(rows).count("undefined") >= 1
+
+
+def test_a_failing_comparison_keeps_the_rows(monkeypatch: pytest.MonkeyPatch) -> None:
+    def broken(rows):
+        raise ArithmeticError("statistics broke")
+
+    monkeypatch.setattr(bench, "compare", broken)
+    family = map_families.family("random-20")
+    logged: list[str] = []
+    rows = bench.run_benchmark([family], bench.contenders(["nearest-path"]), 1, log=logged.append)
+    assert len(rows) == 1 and rows[0]["success"] == 1
+    assert "statistics broke" in rows[0]["comparison_error"] and "rows kept" in logged[0]
 
 
 def _row(policy, t99, heuristic=True):

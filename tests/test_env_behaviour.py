@@ -633,3 +633,27 @@ def test_robots_never_share_a_cell(cells_per_step: int | str) -> None:
                     assert len(path) - 1 <= cells_per_step
                 assert env.world.travelled[index] - travelled[index] == len(path) - 1
     assert steps >= 150
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, "7", True, np.float64(3.0)])
+def test_a_bad_reset_seed_is_named_by_every_env(seed: object) -> None:
+    from frontier_marl.envs.gym_env import FrontierExploreEnv
+
+    for env in (frontier_marl.parallel_env(), FrontierExploreEnv()):
+        with pytest.raises(ValueError, match=r"reset\(seed=\.\.\.\) must be None or an integer"):
+            env.reset(seed=seed)
+    batch = frontier_marl.vector_env(num_envs=2)
+    with pytest.raises(ValueError, match="seed"):
+        batch.reset(seed=seed)
+    with pytest.raises(ValueError, match=r"reset\(seed=\.\.\.\)\[1\] must be None or an integer"):
+        batch.reset(seed=[0, seed])
+
+
+def test_every_env_refuses_a_step_before_reset() -> None:
+    batch = frontier_marl.vector_env(num_envs=2)
+    with pytest.raises(RuntimeError, match=r"before reset\(\)"):
+        batch.step(np.zeros(2, dtype=np.int64))
+    with pytest.raises(RuntimeError, match=r"call reset\(\) first"):
+        frontier_marl.parallel_env().step({"robot_0": 0})
+    batch.reset(seed=0)
+    batch.step(np.zeros(2, dtype=np.int64))  # after reset it steps

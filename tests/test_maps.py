@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import imageio.v3 as iio
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -210,6 +211,26 @@ def test_missing_file_and_unknown_suffix(tmp_path):
         load_map(odd)
     with pytest.raises(ValueError, match="map_path.*does not exist"):
         frontier_marl.parallel_env(map_path=str(tmp_path / "nowhere.txt"))
+
+
+def test_a_folder_binary_bytes_and_a_damaged_png_name_the_file_and_the_fault(tmp_path):
+    with pytest.raises(ValueError, match=f"map_path: map file {tmp_path} is a folder"):
+        frontier_marl.parallel_env(map_path=str(tmp_path))
+    noise = np.random.default_rng(0).integers(0, 256, 300, dtype=np.uint8).tobytes()
+    text = tmp_path / "noise.txt"
+    text.write_bytes(b"\xff" + noise)
+    with pytest.raises(ValueError, match=r"noise\.txt is not a text map: byte 0 is not UTF-8"):
+        load_map(text)
+    fake = tmp_path / "noise.png"
+    fake.write_bytes(noise)
+    with pytest.raises(ValueError, match=r"noise\.png is not a PNG image"):
+        load_map(fake)
+    image = tmp_path / "room.png"
+    iio.imwrite(image, np.full((6, 5), 255, dtype=np.uint8))
+    cut = tmp_path / "cut.png"
+    cut.write_bytes(image.read_bytes()[:40])
+    with pytest.raises(ValueError, match=r"cut\.png is a damaged PNG image"):
+        load_map(cut)
 
 
 # ----------------------------------------------------------------- PGM

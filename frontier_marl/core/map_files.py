@@ -23,11 +23,13 @@ FREE_LEVEL = 250
 def load_map(path: str | Path) -> np.ndarray:
     """The true grid stored in ``path`` (by suffix: .txt, .pgm, .png)."""
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"map file {path} is a folder, not a map file (.txt, .pgm, .png)")
     if not path.is_file():
         raise ValueError(f"map file {path} does not exist")
     suffix = path.suffix.lower()
     if suffix == ".txt":
-        grid = parse_text_map(path.read_text(), str(path))
+        grid = parse_text_map(_read_text(path), str(path))
     elif suffix == ".pgm":
         grid = parse_pgm(path.read_bytes(), str(path))
     elif suffix == ".png":
@@ -121,8 +123,27 @@ def parse_pgm(data: bytes, name: str = "<pgm>") -> np.ndarray:
     return levels < FREE_LEVEL
 
 
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(
+            f"map file {path} is not a text map: byte {error.start} is not UTF-8 text "
+            "(a .txt map holds rows of '#' and '.')"
+        ) from None
+
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
 def _load_png(path: Path) -> np.ndarray:
-    raw = np.asarray(iio.imread(path))
+    with path.open("rb") as handle:
+        if handle.read(len(PNG_SIGNATURE)) != PNG_SIGNATURE:
+            raise ValueError(f"map file {path} is not a PNG image (no PNG signature)")
+    try:
+        raw = np.asarray(iio.imread(path, extension=".png", plugin="pillow"))
+    except Exception as error:  # imageio raises OSError, ValueError or its own errors
+        raise ValueError(f"map file {path} is a damaged PNG image ({error})") from None
     if raw.dtype == bool:
         levels = raw.astype(np.float64) * 255.0
     elif np.issubdtype(raw.dtype, np.integer):

@@ -13,6 +13,7 @@ from frontier_marl.core.world import World
 from frontier_marl.envs.infos import build_infos, check_info_level
 from frontier_marl.render.renderer import RENDER_MODES, Renderer
 from frontier_marl.sim.engine import ExplorationMDP
+from frontier_marl.utils.checks import check_seed
 
 
 class FrontierExploreEnv(gym.Env):
@@ -62,7 +63,7 @@ class FrontierExploreEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed, "reset(seed=...)"))
         observations = self._mdp.reset(self.np_random)
         if self.render_mode == "human":
             self.render()

@@ -13,6 +13,7 @@ from frontier_marl.core.world import World
 from frontier_marl.envs.infos import build_infos, check_info_level
 from frontier_marl.render.renderer import RENDER_MODES, Renderer
 from frontier_marl.sim.engine import ExplorationMDP
+from frontier_marl.utils.checks import check_seed
 
 
 class FrontierParallelEnv(ParallelEnv):
@@ -107,6 +108,7 @@ class FrontierParallelEnv(ParallelEnv):
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+        seed = check_seed(seed, "reset(seed=...)")
         if seed is not None or self._rng is None:
             self._rng = np.random.default_rng(seed)
             self._act_space.seed(None if seed is None else seed + 1)

@@ -20,6 +20,7 @@ from gymnasium.vector.utils import batch_space
 from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.sim.batch_engine import BatchMDP
 from frontier_marl.sim.rewards import REASONS
+from frontier_marl.utils.checks import check_seed
 
 VECTOR_INFO_LEVELS = ("full", "minimal", "mask")
 _REASON_NAMES = np.array(REASONS, dtype=object)
@@ -114,6 +115,8 @@ class FrontierVectorEnv(VectorEnv):
         return self._observations(), self._infos(reset=True)
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if not self._seeded.all():
+            raise RuntimeError("step() called before reset(): call reset() first")
         mdp = self.mdp
         chosen = self._check_actions(actions)
         infos: dict[str, Any] = {}
@@ -152,9 +155,10 @@ class FrontierVectorEnv(VectorEnv):
         if seed is None:
             return [None] * n
         if isinstance(seed, int | np.integer) and not isinstance(seed, bool):
-            return [int(seed) + i for i in range(n)]
+            first = check_seed(seed, "reset(seed=...)")
+            return [first + i for i in range(n)]
         if isinstance(seed, list | tuple) and len(seed) == n:
-            return [None if s is None else int(s) for s in seed]
+            return [check_seed(s, f"reset(seed=...)[{i}]") for i, s in enumerate(seed)]
         raise ValueError(
             f"seed must be an int, None, or a list of {n} seeds (one per world), got {seed!r}"
         )

@@ -97,8 +97,12 @@ def evaluation_env_config(
     preset: str | None = None,
     overrides: dict[str, Any] | None = None,
 ) -> EnvConfig:
-    """The env to evaluate on: the model's training env (from its metadata) with overrides;
-    for a bare SB3 file, ``preset`` (default thesis-20x20) with overrides."""
+    """The env to evaluate on: the model's training env (from its metadata) with overrides.
+
+    A bare SB3 file has no record of its env: ``preset`` and ``overrides`` must name it
+    (ValueError otherwise), and the spaces check still refuses an env whose observations
+    differ from the model's in shape, dtype or bounds.
+    """
     overrides = dict(overrides or {})
     if loaded.metadata is not None:
         if preset is not None:
@@ -108,6 +112,12 @@ def evaluation_env_config(
             geometry = {k: getattr(base, k) for k in ("height", "width", "perception_range")}
             return make_config(config=saved, **{**geometry, **overrides})
         return env_config_from_metadata(loaded.metadata, **overrides)
+    if preset is None and not overrides:
+        raise ValueError(
+            f"model {loaded.path} has no model.json, so the env it was trained on is unknown: "
+            "name it with --preset and --set KEY=VALUE (e.g. --preset thesis-20x20 "
+            "--set normalize=true)"
+        )
     return make_config(preset or "thesis-20x20", **overrides)
 
 

@@ -47,7 +47,7 @@ from frontier_marl.experiments.results import (
     write_table,
 )
 from frontier_marl.policies.metadata import load_metadata
-from frontier_marl.policies.model_files import list_checkpoints
+from frontier_marl.policies.model_files import list_checkpoints, newest_good_checkpoint
 from frontier_marl.training.experiment import experiment_from_dict, load_experiment
 
 __all__ = ["CampaignResult", "RayNotInstalledError", "TrialSpec", "build_grid", "run_campaign"]
@@ -142,10 +142,8 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
         row["reused"] = True
     else:
         experiment = experiment_from_dict(spec.experiment, source=spec.config)
-        checkpoint = None
-        checkpoints = list_checkpoints(run_dir)
-        if checkpoints:
-            checkpoint = checkpoints[-1]
+        checkpoint = newest_good_checkpoint(run_dir)
+        if checkpoint is not None:
             settings = spec.experiment["train"]
             experiment = resume_experiment(
                 checkpoint,
@@ -154,7 +152,8 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
                     for key in ("total_timesteps", "eval_episodes", "torch_threads")
                 },
             )
-        result = train(experiment, run_dir, resume=checkpoint, progress_bar=False)
+        # the campaign owns its run folders: an unfinished run without a checkpoint restarts
+        result = train(experiment, run_dir, resume=checkpoint, progress_bar=False, overwrite=True)
         if result.interrupted or result.evaluation is None:
             raise RuntimeError(
                 f"training of {spec.name} was interrupted at step {result.num_timesteps}"

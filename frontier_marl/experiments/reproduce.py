@@ -167,7 +167,7 @@ def _train_job(
     if cfg.map_mode != "static":
         raise ValueError(f"the thesis protocol needs a static map; {config} has {cfg.map_mode!r}")
     run_dir = out / f"{experiment.name}_seed{seed}"
-    checkpoint = None
+    checkpoint, overwrite = None, False
     if list_checkpoints(run_dir) or (run_dir / "model.zip").exists():
         if not resume:
             raise ValueError(
@@ -178,7 +178,8 @@ def _train_job(
         experiment = resume_experiment(checkpoint, dict(settings))
     elif resume:
         log(f"nothing to resume in {run_dir}: starting a fresh run")
-    return TrainJob(experiment, run_dir, checkpoint, label=f"seed {seed}")
+        overwrite = True  # what an unfinished run left there (a log, its run.json)
+    return TrainJob(experiment, run_dir, checkpoint, label=f"seed {seed}", overwrite=overwrite)
 
 
 def _warm_kernels(experiment: Any) -> None:

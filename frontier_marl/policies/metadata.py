@@ -93,7 +93,13 @@ def load_metadata(model_path: str | Path) -> dict[str, Any] | None:
     path = metadata_path(model_path)
     if not path.is_file():
         return None
-    return json.loads(path.read_text())
+    try:
+        meta = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"model metadata {path} is not valid JSON ({error})") from None
+    if not isinstance(meta, dict):
+        raise ValueError(f"model metadata {path} must hold a JSON object")
+    return meta
 
 
 def env_config_from_metadata(meta: dict[str, Any], **overrides: Any) -> EnvConfig:
@@ -129,15 +135,10 @@ def check_compatible(
                     f"observation layout '{key}': model has {saved.get(key)!r}, "
                     f"env has {current.get(key)!r}"
                 )
-    model_obs, env_obs = (
-        describe_space(model_observation_space),
-        describe_space(env_observation_space),
+    problems += space_differences(
+        "observation space", model_observation_space, env_observation_space
     )
-    if model_obs != env_obs:
-        problems.append(f"observation space: model expects {model_obs}, env gives {env_obs}")
-    model_act, env_act = describe_space(model_action_space), describe_space(env_action_space)
-    if model_act != env_act:
-        problems.append(f"action space: model has {model_act}, env has {env_act}")
+    problems += space_differences("action space", model_action_space, env_action_space)
     if problems:
         raise ModelEnvMismatchError(
             "the model does not match the env:\n  - "
@@ -145,6 +146,36 @@ def check_compatible(
             + "\n(evaluate it on the env it was trained on: drop the conflicting overrides, "
             "or use the env config saved in the model's .json metadata)"
         )
+
+
+def space_differences(
+    name: str, model_space: spaces.Space[Any], env_space: spaces.Space[Any]
+) -> list[str]:
+    """How ``model_space`` differs from ``env_space``: kind, shapes and dtypes, then the bounds
+    of every Box (a model trained on normalised observations must not read raw ones)."""
+    model_desc, env_desc = describe_space(model_space), describe_space(env_space)
+    if model_desc != env_desc:
+        return [f"{name}: model expects {model_desc}, env gives {env_desc}"]
+    if isinstance(model_space, spaces.Dict) and isinstance(env_space, spaces.Dict):
+        return [
+            problem
+            for key in model_space.spaces
+            for problem in space_differences(f"{name} '{key}'", model_space[key], env_space[key])
+        ]
+    if isinstance(model_space, spaces.Box) and model_space != env_space:
+        return [
+            f"{name}: {bound} bounds differ: model {_bounds(getattr(model_space, bound))}, "
+            f"env {_bounds(getattr(env_space, bound))}"
+            for bound in ("low", "high")
+            if not np.array_equal(getattr(model_space, bound), getattr(env_space, bound))
+        ]
+    return []
+
+
+def _bounds(values: np.ndarray) -> str:
+    unique = np.unique(values)
+    shown = ", ".join(f"{v:g}" for v in unique[:4])
+    return f"{{{shown}{', ...' if len(unique) > 4 else ''}}}"
 
 
 def _jsonable(value: Any) -> Any:

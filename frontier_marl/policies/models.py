@@ -27,7 +27,7 @@ from frontier_marl.policies.metadata import (
     env_config_from_metadata,
     load_metadata,
 )
-from frontier_marl.policies.model_files import MODEL_FILE, list_checkpoints
+from frontier_marl.policies.model_files import MODEL_FILE, newest_good_checkpoint
 
 #: name -> one-line description
 PRETRAINED: dict[str, str] = {
@@ -107,9 +107,9 @@ def resolve_model_path(path: str | Path) -> Path:
     if path.is_dir():
         if (path / MODEL_FILE).is_file():
             return path / MODEL_FILE
-        checkpoints = list_checkpoints(path)
-        if checkpoints:
-            return checkpoints[-1].model
+        checkpoint = newest_good_checkpoint(path)
+        if checkpoint is not None:
+            return checkpoint.model
         raise ValueError(f"no {MODEL_FILE} in folder {str(path)!r}")
     if not path.is_file() and path.with_suffix(".zip").is_file():
         path = path.with_suffix(".zip")
@@ -158,8 +158,14 @@ def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
         algorithm = loader(None if metadata is None else metadata.get("algorithm"))
     except MissingExtraError as exc:
         raise MissingExtraError(f"model {str(path)!r}: {exc}") from None
-    with legacy_module_names():
-        model = algorithm.load(model_path, device=device)
+    try:
+        with legacy_module_names():
+            model = algorithm.load(model_path, device=device)
+    except Exception as error:  # SB3 raises whatever its zip, pickle or torch readers raise
+        raise ValueError(
+            f"cannot load model {model_path}: the file is damaged or not a saved "
+            f"{algorithm.__name__} model ({type(error).__name__}: {error})"
+        ) from error
     return LoadedModel(model=model, path=model_path, metadata=metadata)
 
 

@@ -4,6 +4,7 @@ and renamed, so an interrupted save never leaves a half checkpoint behind."""
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 from typing import Any
@@ -12,8 +13,10 @@ from frontier_marl.policies.metadata import save_metadata
 from frontier_marl.policies.model_files import (
     BUFFER_FILE,
     CHECKPOINTS,
+    CHECKSUMS_FILE,
     MODEL_FILE,
     Checkpoint,
+    file_digest,
     list_checkpoints,
 )
 
@@ -34,6 +37,8 @@ def save_checkpoint(
     save_metadata(meta, tmp / "model.json")
     if replay_buffer and hasattr(model, "save_replay_buffer"):
         model.save_replay_buffer(tmp / BUFFER_FILE)
+    digests = {f.name: file_digest(f) for f in sorted(tmp.iterdir()) if f.is_file()}
+    (tmp / CHECKSUMS_FILE).write_text(json.dumps(digests, indent=1) + "\n")
     if final.exists():
         shutil.rmtree(final)
     tmp.rename(final)

@@ -37,34 +37,68 @@ def set_logger(model: Any, run_dir: Path, start_step: int, resumed: bool, verbos
     model.set_logger(Logger(folder=str(run_dir), output_formats=outputs))
 
 
-def record_session(
-    run_dir: Path,
-    experiment: Experiment,
-    start: int,
-    end: int,
-    wall: float,
-    cpu: float,
-    interrupted: bool,
-    resumed_from: Path | None,
-) -> None:
-    """Append this session (steps, wall and CPU time, interruption) to ``RUN/run.json``."""
-    path = run_dir / "run.json"
-    record = json.loads(path.read_text()) if path.is_file() else {"sessions": []}
+def start_session(
+    run_dir: Path, experiment: Experiment, start: int, resumed_from: Path | None
+) -> int:
+    """Record a session in ``RUN/run.json`` as it starts (so a crash cannot lose it); returns
+    its index. A session still marked running was killed without ending: it is marked so."""
+    record = read_run_record(run_dir)
+    for session in record["sessions"]:
+        if session.get("status") == "running":
+            session["status"] = "killed"  # its process ended without recording an end
     record["experiment"] = experiment.to_dict()
     record["sessions"].append(
         {
             "start_step": start,
+            "status": "running",
+            "resumed_from": None if resumed_from is None else str(resumed_from),
+            "machine": machine_name(),
+            "pid": os.getpid(),
+            "started_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
+        }
+    )
+    _write_record(run_dir, record)
+    return len(record["sessions"]) - 1
+
+
+def end_session(
+    run_dir: Path, index: int, end: int, wall: float, cpu: float, interrupted: bool
+) -> None:
+    """Complete session ``index`` of ``RUN/run.json``: steps, wall and CPU time, interruption."""
+    record = read_run_record(run_dir)
+    session = record["sessions"][index]
+    start = session["start_step"]
+    session.update(
+        {
             "end_step": end,
+            "status": "interrupted" if interrupted else "finished",
             "wall_time_s": round(wall, 3),
             "steps_per_second": round((end - start) / wall, 1) if wall > 0 else None,
             "cpu_time_s": round(cpu, 3),
             "interrupted": interrupted,
-            "resumed_from": None if resumed_from is None else str(resumed_from),
-            "machine": machine_name(),
             "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
         }
     )
-    path.write_text(json.dumps(record, indent=2) + "\n")
+    _write_record(run_dir, record)
+
+
+def read_run_record(run_dir: Path) -> dict[str, Any]:
+    """``RUN/run.json`` (the experiment and its sessions), or an empty record."""
+    path = run_dir / "run.json"
+    if not path.is_file():
+        return {"sessions": []}
+    try:
+        return json.loads(path.read_text())
+    except ValueError as error:
+        raise ValueError(f"run record {path} is not valid JSON ({error})") from None
+
+
+def _write_record(run_dir: Path, record: dict[str, Any]) -> None:
+    """Write ``RUN/run.json`` through a temporary file, so a crash leaves the old or the new."""
+    path = run_dir / "run.json"
+    temporary = path.with_name(".run.json.tmp")
+    temporary.write_text(json.dumps(record, indent=2) + "\n")
+    temporary.replace(path)
 
 
 def plot_learning_curve(run_dir: Path, experiment: Experiment, num_timesteps: int) -> Path:

@@ -34,7 +34,12 @@ from frontier_marl.training.experiment import Experiment
 from frontier_marl.training.family_validation import FamilyValidator
 from frontier_marl.training.plots import plot_action_histogram
 from frontier_marl.training.results import TrainResult
-from frontier_marl.training.run_files import plot_learning_curve, record_session, set_logger
+from frontier_marl.training.run_files import (
+    end_session,
+    plot_learning_curve,
+    set_logger,
+    start_session,
+)
 from frontier_marl.training.sb3_algorithm import SB3Algorithm
 from frontier_marl.training.validation import BEST_DIR, BestPolicyKeeper
 from frontier_marl.training.vec_env import make_vec_env
@@ -171,6 +176,8 @@ def train_sb3(
     def checkpoint_now(m: Any) -> Checkpoint:
         return save_checkpoint(m, run_dir, metadata(), keep=settings.keep_checkpoints)
 
+    resumed_from = None if checkpoint is None else checkpoint.path
+    session = start_session(run_dir, experiment, start_step, resumed_from)
     periodic = session_callbacks(experiment, run_dir, metadata, checkpoint_now, start_step)
     started, cpu_started = time.perf_counter(), time.process_time()
     interrupted = learn(model, experiment, checkpoint is None, callbacks, periodic, progress_bar)
@@ -188,10 +195,7 @@ def train_sb3(
     )
     result.files["checkpoint"] = checkpoint_now(model).path
     meta = save_model(model, metadata(), result)
-    resumed_from = None if checkpoint is None else checkpoint.path
-    record_session(
-        run_dir, experiment, start_step, model.num_timesteps, wall, cpu, interrupted, resumed_from
-    )
+    end_session(run_dir, session, model.num_timesteps, wall, cpu, interrupted)
     model.logger.close()
     vec_env.close()
     result.files["learning_curve"] = plot_learning_curve(run_dir, experiment, result.num_timesteps)

@@ -28,15 +28,14 @@ from typing import Any
 import torch
 
 from frontier_marl.policies.model_files import (
-    MODEL_FILE,
     Checkpoint,
     find_checkpoint,
-    list_checkpoints,
 )
 from frontier_marl.training.algorithms import sb3_algorithm
 from frontier_marl.training.cem import train_cem
 from frontier_marl.training.experiment import Experiment, experiment_from_dict
 from frontier_marl.training.results import TrainResult
+from frontier_marl.training.run_folder import own_run_folder
 from frontier_marl.training.sb3_session import train_sb3
 
 #: Train settings a resumed run may change; everything else must match the checkpoint.
@@ -85,24 +84,25 @@ def train(
     progress_bar: bool = True,
     verbose: int = 0,
     callbacks: Sequence[Any] = (),
+    overwrite: bool = False,
 ) -> TrainResult:
     """Train (or resume) one experiment into ``run_dir``; Ctrl-C saves a checkpoint.
 
-    ``callbacks`` are extra SB3 callbacks (e.g. to report to a tuner).
+    The session owns ``run_dir`` while it runs (:mod:`~frontier_marl.training.run_folder`); a
+    fresh run is refused where an earlier run's files lie unless ``overwrite`` (a workflow
+    restarting its own unfinished run). ``callbacks`` are extra SB3 callbacks (e.g. to report
+    to a tuner).
     """
     settings = experiment.train
     run_dir = Path(run_dir)
     checkpoint = find_checkpoint(resume) if isinstance(resume, str | Path) else resume
-    if checkpoint is None and ((run_dir / MODEL_FILE).exists() or list_checkpoints(run_dir)):
-        raise ValueError(
-            f"run folder {str(run_dir)!r} already holds a run: continue it with "
-            f"--resume {run_dir} or choose another --out"
+    if settings.algorithm == "cem" and checkpoint is not None:
+        raise ValueError("a train.algorithm = 'cem' run cannot be resumed: start it again")
+    with own_run_folder(run_dir, fresh=checkpoint is None, overwrite=overwrite):
+        torch.set_num_threads(settings.torch_threads)
+        if settings.algorithm == "cem":
+            return train_cem(experiment, run_dir, progress_bar)
+        algorithm = sb3_algorithm(settings.algorithm)
+        return train_sb3(
+            algorithm, experiment, run_dir, checkpoint, progress_bar, verbose, callbacks
         )
-    run_dir.mkdir(parents=True, exist_ok=True)
-    torch.set_num_threads(settings.torch_threads)
-    if settings.algorithm == "cem":
-        if checkpoint is not None:
-            raise ValueError("a train.algorithm = 'cem' run cannot be resumed: start it again")
-        return train_cem(experiment, run_dir, progress_bar)
-    algorithm = sb3_algorithm(settings.algorithm)
-    return train_sb3(algorithm, experiment, run_dir, checkpoint, progress_bar, verbose, callbacks)

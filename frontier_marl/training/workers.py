@@ -36,12 +36,14 @@ REPORT_EVERY = 1000
 
 @dataclass(frozen=True)
 class TrainJob:
-    """One run: the experiment, its folder, the checkpoint to resume (or None), a label."""
+    """One run: the experiment, its folder, the checkpoint to resume (or None), a label, and
+    whether a fresh run may replace an unfinished one's files (``train``'s ``overwrite``)."""
 
     experiment: Experiment
     run_dir: Path
     checkpoint: Checkpoint | None = None
     label: str = ""
+    overwrite: bool = False
 
 
 @dataclass
@@ -65,7 +67,13 @@ def train_runs(jobs: Sequence[TrainJob], workers: int, progress: bool = True) ->
 def _train_here(jobs: Sequence[TrainJob], progress: bool) -> TrainOutcome:
     results: list[Any] = []
     for job in jobs:
-        result = train(job.experiment, job.run_dir, resume=job.checkpoint, progress_bar=progress)
+        result = train(
+            job.experiment,
+            job.run_dir,
+            resume=job.checkpoint,
+            progress_bar=progress,
+            overwrite=job.overwrite,
+        )
         results.append(result)
         if result.interrupted:
             results += [None] * (len(jobs) - len(results))
@@ -101,6 +109,7 @@ def _run_job(index: int, job: TrainJob) -> Any:
         resume=job.checkpoint,
         progress_bar=False,
         callbacks=[Periodic(REPORT_EVERY, report)],
+        overwrite=job.overwrite,
     )
     _REPORTS.put((index, result.num_timesteps, "done"))
     return result

@@ -41,3 +41,13 @@ def check_range(name: str, value: Any, low: float, high: float, low_open: bool =
     if (value <= low if low_open else value < low) or value > high:
         bracket = "(" if low_open else "["
         raise ValueError(f"{name} must be in {bracket}{low}, {high}], got {value!r}")
+
+
+def check_seed(seed: Any, name: str = "seed") -> int | None:
+    """``seed`` as an int, or None; ValueError naming ``name`` unless it is None or an integer
+    >= 0 (numpy's generators take no negative seed, and a float or a bool is a mistake)."""
+    if seed is None:
+        return None
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ValueError(f"{name} must be None or an integer >= 0, got {seed!r}")
+    return int(seed)

@@ -244,7 +244,14 @@ def run_benchmark(
                         log(f"{contender.name} skipped on {fam.name}: {exc}")
                     continue
                 rows.append(summary_row(result))
-    return compare(rows)
+    try:
+        return compare(rows)
+    except Exception as error:  # the statistics must never lose the episodes already run
+        if log is not None:
+            log(f"warning: the comparison failed ({type(error).__name__}: {error}); rows kept")
+        for row in rows:
+            row["comparison_error"] = f"{type(error).__name__}: {error}"
+        return rows
 
 
 def run_on_seeds(

@@ -38,7 +38,9 @@ def paired_difference(
 ) -> dict[str, Any]:
     """Mean per-episode relative difference ``(v - b) / b`` over the episodes where both
     values exist, and its Student-t confidence interval (sample std, ``n - 1`` degrees of
-    freedom; no interval from fewer than two pairs)."""
+    freedom; no interval from fewer than two pairs). A pair whose baseline is 0 (a map seen
+    whole at reset: T99 = 0) has no relative difference: it is left out and counted in
+    ``undefined``."""
     if len(values) != len(baseline):
         raise ValueError(
             f"values and baseline must pair up episode by episode, got {len(values)} and "
@@ -46,15 +48,22 @@ def paired_difference(
         )
     if not 0.0 < confidence < 1.0:
         raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
-    pairs = [
+    both = [
         (float(v), float(b))
         for v, b in zip(values, baseline, strict=True)
         if v is not None and b is not None
     ]
-    if any(b <= 0 for _, b in pairs):
-        raise ValueError("baseline values must be > 0 for a relative difference")
+    if any(b < 0 for _, b in both):
+        raise ValueError("baseline values must be >= 0 for a relative difference")
+    pairs = [(v, b) for v, b in both if b > 0]
     diffs = np.array([(v - b) / b for v, b in pairs])
-    out: dict[str, Any] = {"pairs": len(diffs), "mean": None, "ci_low": None, "ci_high": None}
+    out: dict[str, Any] = {
+        "pairs": len(diffs),
+        "undefined": len(both) - len(pairs),
+        "mean": None,
+        "ci_low": None,
+        "ci_high": None,
+    }
     if len(diffs) == 0:
         return out
     mean = float(diffs.mean())
@@ -187,14 +196,17 @@ def _versus(row: Mapping[str, Any], metric: str = "t99") -> str:
     diff = row.get(diff_key)
     if row.get(best_key) == row["policy"]:
         return "best"
+    if diff and diff["mean"] is None and diff.get("undefined"):
+        return f"undefined (best T99 = 0 in {diff['undefined']})"
     if not diff or diff["mean"] is None:
         return "—"
     text = f"{diff['mean']:+.1%}"
     if diff["ci_low"] is not None:
         text += f" [{diff['ci_low']:+.1%}, {diff['ci_high']:+.1%}]"
-    if diff["pairs"] < row["episodes"]:
-        text += f" ({diff['pairs']} pairs)"
-    return text
+    notes = [f"{diff['pairs']} pairs"] if diff["pairs"] < row["episodes"] else []
+    if diff.get("undefined"):
+        notes.append(f"{diff['undefined']} undefined: best T99 = 0")
+    return text + (f" ({', '.join(notes)})" if notes else "")
 
 
 def format_table(rows: Sequence[Mapping[str, Any]], markdown: bool = False) -> str:
