@@ -19,6 +19,7 @@ pytest.importorskip("supersuit")
 
 from frontier_marl.training.checkpoints import list_checkpoints  # noqa: E402
 from frontier_marl.training.experiment import experiment_from_dict  # noqa: E402
+from frontier_marl.training.run_folder import RunFolderError  # noqa: E402
 from frontier_marl.training.workers import TrainJob, train_runs  # noqa: E402
 
 pytestmark = pytest.mark.slow  # trains in worker processes
@@ -114,7 +115,7 @@ def test_a_failing_run_stops_the_others_and_raises_its_error(tmp_path: Path) -> 
     blocker.write_text("not a folder")
     healthy = TrainJob(tiny(0, steps=100_000), tmp_path / "seed0", label="seed 0")
     broken = TrainJob(tiny(1), blocker / "seed1", label="seed 1")  # its folder cannot exist
-    with pytest.raises(OSError):
+    with pytest.raises(RunFolderError, match="cannot write the run folder .*seed1"):
         train_runs([healthy, broken], workers=2, progress=False)
     if not healthy.run_dir.exists():
         # On a loaded machine the broken run can fail before the healthy one starts: the
