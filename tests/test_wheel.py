@@ -28,7 +28,9 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 PIP = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
 
-HEURISTICS = ("greedy-distance", "greedy-gain", "cost-utility", "nearest-path", "random")
+HEURISTICS = (
+    "greedy-distance", "greedy-gain", "cost-utility", "nearest-path", "frontier-rule", "random"
+)  # fmt: skip
 
 pytestmark = pytest.mark.slow  # builds a wheel and installs it twice (about a minute)
 

@@ -17,6 +17,7 @@ from frontier_marl.config import make_config
 from frontier_marl.config.thesis import heuristic_baseline
 from frontier_marl.evaluation import evaluate
 from frontier_marl.policies import make_policy
+from frontier_marl.policies.registry import env_settings
 from frontier_marl.utils.json_files import json_safe
 from frontier_marl.utils.progress import progress_bar
 
@@ -63,7 +64,7 @@ def run_baselines(
             bar.set_description(name)
             options = THESIS_PROTOCOL.get(name, {}) if protocol else {}
             result = evaluate(
-                dict(env_kwargs),
+                {**env_kwargs, **env_settings(name)},
                 make_policy(name, seed, **options),
                 episodes=episodes,
                 seed=seed,

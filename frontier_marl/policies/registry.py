@@ -6,6 +6,7 @@ import inspect
 from typing import Any
 
 from frontier_marl.policies.base import Policy
+from frontier_marl.policies.frontier_rule import FrontierRule
 from frontier_marl.policies.heuristics import (
     CostUtility,
     FirstSlot,
@@ -24,12 +25,19 @@ POLICIES: dict[str, type[Policy]] = {
     "nearest-path": NearestPath,
     "random": RandomValid,
     "first-slot": FirstSlot,
+    "frontier-rule": FrontierRule,
     "coordinated-assignment": CoordinatedAssignment,
     "utility-discount": UtilityDiscount,
 }
 
 #: The heuristics that decide for the whole team jointly.
 TEAM_POLICIES: tuple[str, ...] = ("coordinated-assignment", "utility-discount")
+
+
+def env_settings(name: str) -> dict[str, Any]:
+    """The env settings heuristic ``name`` reads (its observation layout), applied on top of
+    the world it runs in; empty for a heuristic that reads the slot table alone."""
+    return dict(getattr(POLICIES[name], "env_settings", {}))
 
 
 def make_policy(name: str, seed: int | None = None, **options: Any) -> Policy:

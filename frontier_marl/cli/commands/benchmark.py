@@ -35,7 +35,7 @@ from frontier_marl.utils.set_options import parse_set_options
 
 #: The default heuristics: the thesis's two, cost-utility and nearest-path; teams add the joint
 #: ones.
-HEURISTICS = ("greedy-distance", "greedy-gain", "cost-utility", "nearest-path")
+HEURISTICS = ("greedy-distance", "greedy-gain", "cost-utility", "nearest-path", "frontier-rule")
 TEAM_HEURISTICS = ("coordinated-assignment", "utility-discount")
 
 

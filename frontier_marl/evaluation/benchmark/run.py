@@ -24,6 +24,7 @@ Statistics (T99, T90, success, the paired difference to the best heuristic) are 
 
 from __future__ import annotations
 
+import inspect
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -48,7 +49,7 @@ from frontier_marl.policies.base import ModelPolicy, Policy
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.policies.metadata import ModelEnvMismatchError
 from frontier_marl.policies.models import PRETRAINED, check_model_env, load_model
-from frontier_marl.policies.registry import POLICIES, make_policy
+from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
 from frontier_marl.utils.progress import progress_bar
 
 ORACLE = "lookahead-oracle"
@@ -75,9 +76,16 @@ def default_commit(agents: int) -> str:
 
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
-    """A heuristic of the registry, with ``commit`` (``random`` has no commit rule)."""
-    options = {} if name == "random" else {"commit": commit}
-    return Contender(name, True, lambda: make_policy(name, 0, **options), lambda cfg: cfg)
+    """A heuristic of the registry, with ``commit`` where it takes one; one that reads an
+    observation layout of its own (``frontier-rule``) runs with it on the family's world."""
+    accepted = inspect.signature(POLICIES[name]).parameters
+    options = {"commit": commit} if "commit" in accepted else {}
+    own = env_settings(name)
+
+    def config(world: EnvConfig) -> EnvConfig:
+        return make_config(None, **{**world_settings(world), **own}) if own else world
+
+    return Contender(name, True, lambda: make_policy(name, 0, **options), config)
 
 
 def model(name: str) -> Contender:
