@@ -165,7 +165,7 @@ def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
 
 def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:
     """Raise ``ModelEnvMismatchError`` if the model cannot act in an env built from ``cfg``."""
-    env = FrontierParallelEnv(config=cfg)
+    env = FrontierParallelEnv(config=cfg, obs_layout="flat")  # the layout models are saved with
     agent = env.possible_agents[0]
     check_compatible(
         cfg,
