@@ -174,6 +174,27 @@ def test_a_model_acts_alike_on_the_classic_and_the_flat_layout() -> None:
     assert results[0].to_dict() == results[1].to_dict()
 
 
+def test_models_of_either_layout_pass_the_model_check_and_act() -> None:
+    pytest.importorskip("stable_baselines3")
+    from pathlib import Path
+
+    from stable_baselines3 import DQN
+
+    from frontier_marl.policies import ModelPolicy
+    from frontier_marl.policies.metadata import ModelEnvMismatchError
+    from frontier_marl.policies.models import LoadedModel, check_model_env
+
+    cfg = frontier_marl.make_config(action_mask=True)
+    obs, info = frontier_marl.FrontierExploreEnv(config=cfg).reset(seed=0)  # classic
+    for layout in ("classic", "flat"):
+        env = frontier_marl.FrontierExploreEnv(config=cfg, obs_layout=layout)
+        model = DQN("MultiInputPolicy", env, buffer_size=10, learning_starts=10)
+        check_model_env(LoadedModel(model, Path("model.zip"), None), cfg)
+        assert 0 <= ModelPolicy(model).act(obs, info) < cfg.n_slots
+    with pytest.raises(ModelEnvMismatchError):
+        check_model_env(LoadedModel(model, Path("model.zip"), None), cfg.replace(n_slots=5))
+
+
 # ----------------------------------------------------------------------------- keywords, ids
 @pytest.mark.parametrize(
     "make",
