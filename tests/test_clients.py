@@ -65,22 +65,23 @@ def test_torchrl_gym_env_builds_every_id_and_masks_with_action_mask() -> None:
 
 
 # ----------------------------------------------------------------------------- Tianshou
-def _tianshou_masked_random() -> Any:
-    """A Tianshou policy choosing uniformly among the valid slots of a classic observation."""
+def _tianshou_random(masked: bool) -> Any:
+    """A Tianshou policy choosing uniformly among the valid slots of a classic observation
+    (``masked``) or among all slots, padding included."""
     from tianshou.algorithm.algorithm_base import Policy
     from tianshou.data import Batch
 
-    class MaskedRandom(Policy):
+    class Random(Policy):
         def __init__(self, action_space: Any) -> None:
             super().__init__(action_space=action_space)
             self.rng = np.random.default_rng(0)
 
         def forward(self, batch: Any, state: Any = None, **kwargs: Any) -> Any:
             mask = np.asarray(batch.obs.action_mask) > 0
-            scores = np.where(mask, self.rng.random(mask.shape), -np.inf)
-            return Batch(act=scores.argmax(axis=-1), state=state)
+            scores = self.rng.random(mask.shape)
+            return Batch(act=np.where(mask | (not masked), scores, -1).argmax(axis=-1))
 
-    return MaskedRandom
+    return Random
 
 
 @pytest.mark.parametrize("n_agents", TEAMS)
@@ -114,7 +115,8 @@ def test_tianshou_pettingzoo_env_collects_with_masked_policies(n_agents: int) ->
     assert batch.info.slots.shape == (len(actions), 4, 10)
 
 
-def test_tianshou_collector_batches_the_gymnasium_env_infos() -> None:
+@pytest.mark.parametrize("masked", [True, False], ids=["masked", "uniform"])
+def test_tianshou_collector_batches_the_gymnasium_env_infos(masked: bool) -> None:
     pytest.importorskip("tianshou")
     from tianshou.data import Collector, VectorReplayBuffer
     from tianshou.env import DummyVectorEnv
@@ -123,7 +125,7 @@ def test_tianshou_collector_batches_the_gymnasium_env_infos() -> None:
         return gymnasium.make(frontier_marl.GYM_ID, action_mask=True)
 
     venv = DummyVectorEnv([make, make])
-    policy = _tianshou_masked_random()(venv.action_space[0])
+    policy = _tianshou_random(masked)(venv.action_space[0])
     collector = Collector(policy, venv, VectorReplayBuffer(1000, 2))
     collector.reset()
     with warnings.catch_warnings():
@@ -132,7 +134,8 @@ def test_tianshou_collector_batches_the_gymnasium_env_infos() -> None:
     assert stats.n_collected_episodes >= 1
     batch = collector.buffer.sample(0)[0]
     chosen = batch.obs.action_mask[np.arange(len(batch.act)), batch.act]
-    assert chosen.all() and not batch.info.padding.any()
+    assert chosen.all() == masked  # uniform: padding slots chosen, their targets [-1, -1]
+    assert batch.info.padding.any() != masked
     assert batch.info.target.shape == (len(batch.act), 2)
 
 
