@@ -6,7 +6,7 @@ Entry points::
     par = frontier_marl.parallel_env(preset="thesis-20x20", n_agents=2)   # PettingZoo Parallel
     aec = frontier_marl.env(preset="thesis-20x20")                        # PettingZoo AEC
     import gymnasium as gym
-    single = gym.make("frontier_marl/FrontierExplore-v0", preset="thesis-20x20")
+    single = gym.make("frontier_marl/FrontierExplore-v1", preset="thesis-20x20")
     batch = frontier_marl.vector_env(num_envs=64, preset="thesis-20x20")  # Gymnasium VectorEnv
 """
 
@@ -19,6 +19,7 @@ from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
 from frontier_marl.config import EnvConfig, ObservationConfig, RewardConfig, make_config
 from frontier_marl.envs import FrontierExploreEnv, FrontierParallelEnv
+from frontier_marl.envs.infos import END_REASONS, SLOT_COLUMNS, reason_name, slot_table
 from frontier_marl.envs.registration import GYM_ID, PETTINGZOO_ID, register_envs
 from frontier_marl.envs.vector import FrontierVectorEnv, vector_env
 
@@ -44,6 +45,8 @@ def env(**kwargs: Any) -> Any:
 register_envs()
 
 __all__ = [
+    "END_REASONS",
+    "SLOT_COLUMNS",
     "GYM_ID",
     "PETTINGZOO_ID",
     "EnvConfig",
@@ -56,5 +59,7 @@ __all__ = [
     "make_config",
     "parallel_env",
     "raw_env",
+    "reason_name",
+    "slot_table",
     "vector_env",
 ]

@@ -73,7 +73,7 @@ def test_make_by_id(preset: str, by_variant: bool) -> None:
     obs, info = env.reset(seed=0)
     assert env.observation_space.contains(obs)
     assert base.world.true_grid.shape == (side, side)
-    assert {"explored_fraction", "new_cells", "action_mask", "slots", "path"} <= set(info)
+    assert {"explored_fraction", "new_cells", "action_mask", "slots", "target"} <= set(info)
 
 
 def test_make_passes_overrides() -> None:
@@ -104,7 +104,7 @@ def test_bad_parameter_raises_at_construction() -> None:
         FrontierExploreEnv(preset="thesis-99x99")
     with pytest.raises(ValueError, match="n_slots"):
         FrontierExploreEnv(n_slots=0)
-    with pytest.raises(ValueError, match="unknown parameter"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'no_such_key'"):
         FrontierExploreEnv(no_such_key=1)
 
 

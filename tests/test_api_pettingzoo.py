@@ -116,7 +116,7 @@ def test_aec_steps_the_team_once_per_cycle() -> None:
 
 def test_metadata() -> None:
     env = frontier_marl.parallel_env()
-    assert env.metadata["name"] == "frontier_explore_v0"
+    assert env.metadata["name"] == "frontier_explore_v1"
     assert set(env.metadata["render_modes"]) == {"human", "rgb_array", "ansi"}
     assert env.metadata["is_parallelizable"] is True
 

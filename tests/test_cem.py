@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import torch
 
-from frontier_marl import FrontierParallelEnv
+from frontier_marl import FrontierParallelEnv, reason_name
 from frontier_marl.cli.main import main
 from frontier_marl.experiments.explorer_studies import (
     ablation,
@@ -81,12 +81,13 @@ def _single_env_t99(cfg, seed: int, weights: np.ndarray) -> int | None:  # noqa:
     while True:
         obs = observations["robot_0"]
         scores = np.where(
-            obs["action_mask"] > 0, obs["slots"].astype(np.float64) @ weights, -np.inf
+            obs["action_mask"] > 0, obs["observation"].astype(np.float64) @ weights, -np.inf
         )
         observations, _, terminated, truncated, infos = env.step({"robot_0": int(scores.argmax())})
         if terminated["robot_0"] or truncated["robot_0"]:
             info = infos["robot_0"]
-            return int(info["travelled"]) if info["end_reason"] == "threshold" else None
+            reached = reason_name(info["end_reason"]) == "threshold"
+            return int(info["travelled"]) if reached else None
 
 
 def test_batched_rollouts_play_the_single_env_episodes() -> None:
@@ -113,7 +114,7 @@ def test_the_linear_model_scores_slots_by_their_features() -> None:
     cfg = _config()[0]
     weights = np.linspace(-1.0, 1.0, len(feature_names(cfg)))
     model = linear_model(cfg, weights)
-    env = FrontierParallelEnv(config=cfg)
+    env = FrontierParallelEnv(config=cfg, obs_layout="flat")  # the layout SB3 models take
     obs = env.reset(seed=5)[0]["robot_0"]
     q_values = model.q_net(model.policy.obs_to_tensor(obs)[0])[0]
     valid = obs["action_mask"] > 0

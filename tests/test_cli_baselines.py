@@ -140,7 +140,7 @@ def test_team_and_dynamic_options(tmp_path):
     [
         (["--policies", "greedy-distance,nearest"], "unknown policy 'nearest'"),
         (["--set", "obstacle_prob=2"], "obstacle_prob"),
-        (["--set", "no_such_key=1"], "unknown parameter"),
+        (["--set", "no_such_key=1"], "unexpected keyword argument 'no_such_key'"),
         (["--set", "height"], "key=value"),
         (["--set", "cells_per_step=fast"], "cells_per_step"),
     ],

@@ -327,7 +327,7 @@ def test_static_mode_start_cells_differ_across_seeds_gym() -> None:
     starts = set()
     for seed in range(10):
         _, info = env.reset(seed=seed)
-        starts.add(info["position"])
+        starts.add(tuple(info["position"].tolist()))
     assert len(starts) >= 5
 
 

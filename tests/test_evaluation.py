@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import frontier_marl
+from frontier_marl import reason_name, slot_table
 from frontier_marl.config.thesis import HEURISTIC_BASELINES, heuristic_baseline
 from frontier_marl.evaluation import evaluate
 from frontier_marl.evaluation.metrics import (
@@ -35,7 +36,7 @@ TINY = {
 
 def nearest(info: dict) -> int:
     """Greedy distance, written independently of frontier_marl.evaluation."""
-    clusters = info["slots"].rows()
+    clusters = slot_table(info).rows()
     if not clusters:
         return 0
     return sorted(clusters, key=lambda c: (c["distance"], c["slot"]))[0]["slot"]
@@ -69,7 +70,7 @@ def manual_episode(env_kwargs: dict, seed: int) -> dict:
         "reward": float(np.mean([returns[a] for a in agents])),
         "robot_rewards": [returns[a] for a in agents],
         "steps": steps,
-        "end_reason": infos[agents[0]]["end_reason"],
+        "end_reason": reason_name(infos[agents[0]]["end_reason"]),
         "travelled": travelled[-1],
         "counts": counts.tolist(),
         "first": first,

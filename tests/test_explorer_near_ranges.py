@@ -31,7 +31,7 @@ def test_the_feature_reads_the_square_of_its_half_side(near_ranges, half_side) -
     for _ in range(5):
         table = SlotArrays.stack(env.mdp.slot_tables())
         expected = unknown_near(table, env.world.belief[None], half_side)[0, :, 0]
-        assert np.array_equal(observations["robot_0"]["slots"][:, -1], expected)
+        assert np.array_equal(observations["robot_0"]["observation"][:, -1], expected)
         mask = observations["robot_0"]["action_mask"]
         observations, *_ = env.step({"robot_0": int(np.flatnonzero(mask)[0])})
 

@@ -8,8 +8,10 @@ import pytest
 import torch
 
 import frontier_marl
+from frontier_marl import slot_table
 from frontier_marl.config import make_config
 from frontier_marl.core.slots import SlotArrays, SlotTable
+from frontier_marl.policies.base import target_cell
 from frontier_marl.sim.features import (
     CELLS,
     EXPLORER_FEATURES,
@@ -98,9 +100,9 @@ def test_tour_lengths_match_the_plain_tour_on_random_tables(seed: int) -> None:
 def test_the_tour_feature_extends_the_explorer_layout_and_needs_it() -> None:
     env = frontier_marl.parallel_env(**EXPLORER, tour=True)
     observations, _ = env.reset(seed=3)
-    slots = observations["robot_0"]["slots"]
+    slots = observations["robot_0"]["observation"]
     assert slots.shape == (6, len(EXPLORER_FEATURES) + 1)
-    without = frontier_marl.parallel_env(**EXPLORER).reset(seed=3)[0]["robot_0"]["slots"]
+    without = frontier_marl.parallel_env(**EXPLORER).reset(seed=3)[0]["robot_0"]["observation"]
     assert np.array_equal(slots[:, :-1], without)
     with pytest.raises(ValueError, match="tour=True needs features='explorer'"):
         make_config("thesis-20x20", tour=True)
@@ -140,12 +142,12 @@ def test_the_turn_feature_follows_the_robots_own_steps() -> None:
     cells = [env.world.positions[0].copy()]
     for _ in range(12):
         obs = observations["robot_0"]
-        assert obs["slots"].shape == (6, len(EXPLORER_FEATURES) + 2)
+        assert obs["observation"].shape == (6, len(EXPLORER_FEATURES) + 2)
         oldest = cells[max(len(cells) - 1 - TRAIL_STEPS, 0)]
         here = env.world.positions[0]
         table = env.mdp.slot_tables()[0]
         expected = turn_costs(SlotArrays.stack([table]), here[None], (here - oldest)[None])
-        assert np.array_equal(obs["slots"][:, -1], expected[0, :, 0])
+        assert np.array_equal(obs["observation"][:, -1], expected[0, :, 0])
         observations, *_ = env.step({"robot_0": int(np.flatnonzero(obs["action_mask"])[-1])})
         cells.append(env.world.positions[0].copy())
     with pytest.raises(ValueError, match="turn=True needs features='explorer'"):
@@ -201,7 +203,7 @@ def test_the_unknown_near_feature_reads_the_shared_belief() -> None:
     for _ in range(8):
         tables = env.mdp.slot_tables()
         for agent, name in enumerate(env.agents):
-            slots = observations[name]["slots"]
+            slots = observations[name]["observation"]
             assert slots.shape == (6, len(EXPLORER_FEATURES) + 2)
             expected = unknown_near(SlotArrays.stack([tables[agent]]), env.world.belief[None])
             assert np.array_equal(slots[:, -1], expected[0, :, 0])
@@ -227,7 +229,7 @@ def test_the_fill_feature_is_the_size_over_the_split_size_on_a_finer_grid() -> N
     observations, _ = env.reset(seed=0)
     for _ in range(10):
         table = env.mdp.slot_tables()[0]
-        slots = observations["robot_0"]["slots"]
+        slots = observations["robot_0"]["observation"]
         expected = np.where(table.valid, table.size / 14, 0.0)
         assert slots[:, column] == pytest.approx(expected)
         assert (slots[:, column] <= 1).all()
@@ -256,7 +258,7 @@ def test_the_utility_feature_in_the_observation() -> None:
     observations, _ = env.reset(seed=3)
     for _ in range(6):
         table = SlotArrays.stack([env.mdp.slot_tables()[0]])
-        slots = observations["robot_0"]["slots"]
+        slots = observations["robot_0"]["observation"]
         assert np.array_equal(slots[:, -1], log_utility(table, 5)[0, :, 0])
         assert np.isfinite(slots).all()
         action = int(np.flatnonzero(observations["robot_0"]["action_mask"])[0])
@@ -270,7 +272,7 @@ def test_slot_feature_names_follow_the_encoders_columns() -> None:
     env = frontier_marl.parallel_env(**EXPLORER, **kwargs, teammates="positions+targets")
     observations, _ = env.reset(seed=6)
     names = slot_feature_names(env.config.observation)
-    slots = observations["robot_0"]["slots"]
+    slots = observations["robot_0"]["observation"]
     assert slots.shape[1] == len(names) == len(EXPLORER_FEATURES) + 7
     table = SlotArrays.stack([env.mdp.slot_tables()[0]])
     expected = unknown_near(table, env.world.belief[None])[0, :, 0]
@@ -302,9 +304,9 @@ def test_team_explorer_observation_does_not_depend_on_the_team_size() -> None:
     spaces = [frontier_marl.parallel_env(n_agents=k, **kwargs).observation_space("robot_0")
               for k in (2, 4, 8)]  # fmt: skip
     assert spaces[0] == spaces[1] == spaces[2]
-    assert spaces[0]["slots"].shape == (6, len(EXPLORER_FEATURES) + 3)
+    assert spaces[0]["observation"].shape == (6, len(EXPLORER_FEATURES) + 3)
     one = frontier_marl.parallel_env(preset="rooms-32", **EXPLORER).observation_space("robot_0")
-    assert one["slots"].shape == (6, len(EXPLORER_FEATURES))  # the one-robot layout is kept
+    assert one["observation"].shape == (6, len(EXPLORER_FEATURES))  # the one-robot layout is kept
 
 
 def test_explorer_observation_does_not_depend_on_the_map_size() -> None:
@@ -341,12 +343,13 @@ def test_heuristics_take_the_until_reached_rule() -> None:
         for _ in range(60):
             actions = policy.act_team(observations, infos)
             observations, _, _, _, infos = env.step(actions)
-            target, table = infos["robot_0"]["target"], infos["robot_0"]["slots"]
+            info = infos["robot_0"]
+            target, table = target_cell(info["target"]), slot_table(info)
             offered = {tuple(cell) for cell in table.target[: table.live].tolist()}
             if previous is not None and previous in offered:
                 assert target == previous, f"{name} left an offered target {previous} for {target}"
                 kept += 1
-            previous = target if infos["robot_0"]["position"] != target else None
+            previous = target if tuple(info["position"].tolist()) != target else None
         assert kept >= 5, f"{name}: the commitment was tested on {kept} steps only"
 
 
@@ -368,7 +371,7 @@ def test_batched_and_single_explorer_observations_agree() -> None:
         action = int(infos["action_mask"][0].argmax())
         observations, rewards, *_, infos = vec.step(np.array([action, 0]))
         expected, single_rewards, *_ = single.step({"robot_0": action})
-        assert np.array_equal(observations["slots"][0], expected["robot_0"]["slots"])
+        assert np.array_equal(observations["observation"][0], expected["robot_0"]["observation"])
         assert rewards[0] == single_rewards["robot_0"]
 
 

@@ -90,7 +90,7 @@ def test_imitation_labels_real_decisions_and_fits_them() -> None:
     world = variant_configs(family("random-20"))[0]
     cfg = make_config(config=world, **own)
     data = Dataset()
-    env = FrontierParallelEnv(config=cfg)
+    env = FrontierParallelEnv(config=cfg, obs_layout="flat")
     travelled = play(env, 5, data, None, 1.0, np.random.default_rng(0))
     assert len(data) > 0 and travelled > 0
     slots, masks, targets, valid = data.tensors()

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 import frontier_marl
+from frontier_marl import slot_table
 from frontier_marl.cli.main import main
 from frontier_marl.config import make_config
 from frontier_marl.core.example_maps import example_map_path
@@ -58,7 +59,7 @@ def corridor_env(path: str, **kwargs: Any) -> tuple[Any, dict, dict]:
 
 
 def slot_of(info: dict, target: tuple[int, int]) -> int:
-    return next(c["slot"] for c in info["slots"].rows() if c["target"] == target)
+    return next(c["slot"] for c in slot_table(info).rows() if c["target"] == target)
 
 
 def padding_slot(info: dict) -> int:
@@ -247,7 +248,7 @@ def team_states(draw: st.DrawFn) -> tuple[dict[str, dict], dict[int, tuple[int, 
 def chosen_clusters(infos: dict[str, dict], actions: dict[str, int]) -> dict[str, int | None]:
     out = {}
     for agent, slot in actions.items():
-        match = [c["cluster"] for c in infos[agent]["slots"].rows() if c["slot"] == slot]
+        match = [c["cluster"] for c in slot_table(infos[agent]).rows() if c["slot"] == slot]
         out[agent] = match[0] if match else None
     return out
 
@@ -258,7 +259,7 @@ def best_distinct_assignment(infos: dict[str, dict]) -> tuple[int, int]:
     options = []
     for info in infos.values():
         dist = bfs_distances(info["belief"] == FREE, info["position"])
-        options.append([(c["cluster"], int(dist[c["target"]])) for c in info["slots"].rows()])
+        options.append([(c["cluster"], int(dist[c["target"]])) for c in slot_table(info).rows()])
     best = (0, 0)
     for combo in itertools.product(*[[None, *opts] for opts in options]):
         picked = [o for o in combo if o is not None]
@@ -278,7 +279,7 @@ def test_coordinated_assignment_never_duplicates_an_avoidable_target(state):
     clusters = chosen_clusters(infos, actions)
     for agent, slot in actions.items():
         assert infos[agent]["action_mask"][slot] == 1  # always a live slot (or idle slot 0)
-        assert (clusters[agent] is None) == (not infos[agent]["slots"].rows())
+        assert (clusters[agent] is None) == (not slot_table(infos[agent]).rows())
     distinct, shortest = best_distinct_assignment(infos)
     picked = [c for c in clusters.values() if c is not None]
     assert len(set(picked)) == distinct  # as many robots on their own cluster as possible
@@ -289,7 +290,7 @@ def test_coordinated_assignment_never_duplicates_an_avoidable_target(state):
             if cluster is None:
                 continue
             info = infos[agent]
-            target = next(c["target"] for c in info["slots"].rows() if c["cluster"] == cluster)
+            target = next(c["target"] for c in slot_table(info).rows() if c["cluster"] == cluster)
             lengths.append(int(bfs_distances(info["belief"] == FREE, info["position"])[target]))
         assert sum(lengths) == shortest  # and of the least total path length
 
@@ -348,9 +349,9 @@ def test_one_robot_in_a_real_episode_follows_the_shortest_path_rule(name):
     while env.agents:
         info = infos["robot_0"]
         action = policy.act_team(obs, infos)["robot_0"]
-        if info["slots"].rows():
-            dist = bfs_distances(env.world.belief == FREE, info["position"])
-            lengths = {c["slot"]: dist[c["target"]] for c in info["slots"].rows()}
+        if slot_table(info).rows():
+            dist = bfs_distances(env.world.belief == FREE, tuple(info["position"]))
+            lengths = {c["slot"]: dist[c["target"]] for c in slot_table(info).rows()}
             assert lengths[action] == min(lengths.values())
         obs, _, _, _, infos = env.step({"robot_0": action})
         steps += 1

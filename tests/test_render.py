@@ -239,3 +239,30 @@ def test_human_viewer_shows_each_frame_in_its_own_figure_and_closes_it() -> None
     assert not plt.fignum_exists(number) and plt.fignum_exists(second._fig.number)
     first.close()  # closing twice is safe
     second.close()
+
+
+def test_two_human_mode_envs_render_side_by_side(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each env has a viewer figure of its own: a second env, and an env made while an
+    earlier one is still open, render beside it."""
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    import frontier_marl
+
+    monkeypatch.setattr(plt, "pause", lambda interval: None)  # the frames, not the sleep
+    first = frontier_marl.parallel_env(render_mode="human", n_agents=2)
+    second = frontier_marl.FrontierExploreEnv(render_mode="human")
+    first.reset(seed=0)
+    second.reset(seed=1)
+    for _ in range(3):
+        first.step(dict.fromkeys(first.agents, 0))
+        second.step(0)
+    figures = {first._renderer._viewer._fig.number, second._renderer._viewer._fig.number}
+    assert len(figures) == 2 and all(plt.fignum_exists(number) for number in figures)
+    third = frontier_marl.parallel_env(render_mode="human")  # while the others are open
+    third.reset(seed=2)
+    assert plt.fignum_exists(third._renderer._viewer._fig.number)
+    for env in (first, second, third):
+        env.close()
+    assert not any(plt.fignum_exists(number) for number in figures)

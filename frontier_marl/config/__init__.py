@@ -10,7 +10,13 @@ Options that the thesis left open are marked "open choice" below; ``docs/thesis-
 lists them with the reason for each default.
 """
 
-from frontier_marl.config.env_config import EnvConfig, config_keys
+from frontier_marl.config.env_config import (
+    ALIASES,
+    EnvConfig,
+    UnknownKeywordError,
+    config_keys,
+    reject_unknown,
+)
 from frontier_marl.config.options import (
     FULL_PATH,
     CentroidEncoding,
@@ -30,6 +36,7 @@ from frontier_marl.config.options import (
 from frontier_marl.config.presets import PRESETS, config_to_dict, make_config
 
 __all__ = [
+    "ALIASES",
     "FULL_PATH",
     "PRESETS",
     "CentroidEncoding",
@@ -46,7 +53,9 @@ __all__ = [
     "StartCells",
     "TeammateEncoding",
     "ThresholdBasis",
+    "UnknownKeywordError",
     "config_keys",
     "config_to_dict",
     "make_config",
+    "reject_unknown",
 ]

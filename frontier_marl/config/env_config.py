@@ -166,18 +166,52 @@ REWARD_KEYS = {f.name for f in dataclasses.fields(RewardConfig)} - {"kind"}
 ENV_KEYS = {f.name for f in dataclasses.fields(EnvConfig)} - {"observation", "reward"}
 
 
+#: Other libraries' names for a keyword: PettingZoo calls the step limit ``max_cycles``.
+ALIASES = {"max_cycles": "max_steps"}
+
+
+class UnknownKeywordError(TypeError, ValueError):
+    """An unknown keyword: a ``TypeError``, as Python raises for an unexpected keyword argument
+    (clients such as TorchRL's ``GymEnv`` retry without a keyword on it), and a ``ValueError``,
+    as every other bad parameter of the config."""
+
+
 def config_keys() -> list[str]:
     """Every flat keyword accepted by :func:`make_config`."""
     return sorted(ENV_KEYS | OBS_KEYS | REWARD_KEYS | {"reward", "preset", "config"})
 
 
+def reject_unknown(given: Any, allowed: Any, owner: str) -> None:
+    """Raise :class:`UnknownKeywordError` naming the keywords of ``given`` that ``allowed``
+    lacks (Python's wording) and listing the allowed ones."""
+    unknown = sorted(set(given) - set(allowed))
+    if unknown:
+        names = ", ".join(repr(name) for name in unknown)  # Python's wording: clients match it
+        what = "an unexpected keyword argument"
+        if len(unknown) > 1:
+            what = "unexpected keyword arguments"
+        raise UnknownKeywordError(
+            f"{owner}() got {what} {names}; allowed: {', '.join(sorted(allowed))}"
+        )
+
+
+def resolve_aliases(overrides: dict[str, Any]) -> dict[str, Any]:
+    """``overrides`` with :data:`ALIASES` renamed (``TypeError`` if both names are given)."""
+    for alias, name in ALIASES.items():
+        if alias in overrides:
+            if name in overrides:
+                raise TypeError(f"give {name} or {alias} (another name for it), not both")
+            overrides = {**overrides, name: overrides[alias]}
+            del overrides[alias]
+    return overrides
+
+
 def apply_overrides(cfg: EnvConfig, overrides: dict[str, Any]) -> EnvConfig:
     """``cfg`` with flat keyword overrides applied (validated by the dataclasses)."""
-    unknown = set(overrides) - (ENV_KEYS | OBS_KEYS | REWARD_KEYS | {"reward", "observation"})
-    if unknown:
-        raise ValueError(
-            f"unknown parameter(s) {sorted(unknown)}; allowed: {', '.join(config_keys())}"
-        )
+    overrides = resolve_aliases(overrides)
+    allowed = ENV_KEYS | OBS_KEYS | REWARD_KEYS | {"reward", "observation"}
+    if set(overrides) - allowed:
+        reject_unknown(overrides, allowed | set(config_keys()) | set(ALIASES), "make_config")
     env_kw = {k: v for k, v in overrides.items() if k in ENV_KEYS}
     if env_kw.get("map_path") is not None:
         if isinstance(env_kw["map_path"], os.PathLike):

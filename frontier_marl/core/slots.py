@@ -29,6 +29,21 @@ from frontier_marl.core.planning import distance_field
 _ARRAYS = ("cluster", "valid", "centroid", "target", "distance", "size", "gain", "path_length")
 _FIELDS = (*_ARRAYS, "mask")
 
+#: The columns of a packed slot table (:meth:`SlotArrays.packed`; the env info's ``slots``):
+#: one float64 row per slot, the integers exact, padding rows as in :class:`SlotTable`.
+SLOT_COLUMNS = (
+    "cluster",
+    "valid",
+    "centroid_row",
+    "centroid_col",
+    "target_row",
+    "target_col",
+    "distance",
+    "path_length",
+    "size",
+    "gain",
+)
+
 
 @dataclass(eq=False, slots=True)
 class SlotTable:
@@ -90,6 +105,31 @@ class SlotTable:
         """int8 mask of the actions worth taking: the live slots, or slot 0 (idle) if none."""
         return self.mask
 
+    @classmethod
+    def from_packed(cls, packed: np.ndarray, mask: np.ndarray) -> SlotTable:
+        """The table of a packed ``(n_slots, 10)`` array (:data:`SLOT_COLUMNS`) and its action
+        mask: the same values, in the table's dtypes."""
+        rows = np.asarray(packed)
+        if rows.ndim != 2 or rows.shape[1] != len(SLOT_COLUMNS):
+            raise ValueError(f"a packed slot table has shape (n_slots, 10), got {rows.shape}")
+
+        def whole(columns: Any) -> np.ndarray:
+            return np.array(rows[:, columns], dtype=np.int64, order="C")
+
+        valid = rows[:, 1] != 0
+        return cls(
+            cluster=whole(0),
+            valid=valid,
+            centroid=np.array(rows[:, 2:4], order="C"),
+            target=whole(slice(4, 6)),
+            distance=np.array(rows[:, 6]),
+            size=whole(8),
+            gain=np.array(rows[:, 9]),
+            path_length=whole(7),
+            mask=np.asarray(mask),
+            live=int(np.count_nonzero(valid)),
+        )
+
 
 @dataclass(slots=True)
 class SlotArrays:
@@ -112,6 +152,21 @@ class SlotArrays:
         """The tables of M robots as ``(M, ...)`` arrays."""
         fields = {name: np.stack([getattr(t, name) for t in tables]) for name in _FIELDS}
         return cls(**fields, live=np.array([t.live for t in tables], dtype=np.int64))
+
+    def packed(self) -> np.ndarray:
+        """The fields as one float64 array ``(..., n_slots, 10)`` in :data:`SLOT_COLUMNS`'s
+        order (the mask is left out: it is the action mask)."""
+        columns = (
+            self.cluster[..., None],
+            self.valid[..., None],
+            self.centroid,
+            self.target,
+            self.distance[..., None],
+            self.path_length[..., None],
+            self.size[..., None],
+            self.gain[..., None],
+        )
+        return np.concatenate(columns, axis=-1, dtype=np.float64)
 
     def table(self, row: int) -> SlotTable:
         """Robot ``row``'s :class:`SlotTable` (views) of ``(M, ...)`` arrays."""

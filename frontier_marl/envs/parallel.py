@@ -8,16 +8,18 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from frontier_marl.config import EnvConfig, make_config
+from frontier_marl.config import EnvConfig
 from frontier_marl.core.world import World
 from frontier_marl.envs.infos import build_infos, check_info_level
+from frontier_marl.envs.keywords import adapter_config
+from frontier_marl.envs.layout import ObservationLayout
 from frontier_marl.render.renderer import RENDER_MODES, Renderer
 from frontier_marl.sim.engine import ExplorationMDP
 from frontier_marl.utils.checks import check_seed
 
 
 class FrontierParallelEnv(ParallelEnv):
-    """Frontier-based exploration by N robots sharing one belief grid (frontier_explore_v0).
+    """Frontier-based exploration by N robots sharing one belief grid (frontier_explore_v1).
 
     **Description.** A team of robots explores an unknown 2D grid. At each decision step every
     robot picks one *slot*: a frontier cluster (contiguous known-free cells next to unknown
@@ -32,8 +34,11 @@ class FrontierParallelEnv(ParallelEnv):
     ``info[agent]["action_mask"]`` (and in the observation when ``action_mask=True``).
 
     **Observation space.** A flat ``Box`` of ``n_slots x F`` slot features, or a ``Dict`` with
-    ``clusters``, ``agent_position`` and ``action_mask`` keys; see
-    :mod:`frontier_marl.sim.observations`.
+    ``clusters`` and ``agent_position`` keys; see :mod:`frontier_marl.sim.observations`. With
+    ``action_mask=True`` (and in the explorer layout), PettingZoo's classic
+    ``{"observation": ..., "action_mask": ...}`` (``obs_layout="classic"``, the default) or
+    the mask beside the other keys (``obs_layout="flat"``, what SB3 routes and saved models
+    use); see :mod:`frontier_marl.envs.layout`.
 
     **Rewards.** Reward 1 or Reward 2 of the thesis (:mod:`frontier_marl.sim.rewards`).
 
@@ -44,24 +49,27 @@ class FrontierParallelEnv(ParallelEnv):
     robot has a reachable frontier left; truncated by the step limit, by ``no_progress_limit``
     steps without a new cell, or (Reward 1) by a padding action.
 
-    **Arguments.** ``preset`` (``thesis-20x20`` or ``thesis-30x30``), ``render_mode``,
-    ``info`` (``full`` or ``minimal``), and any field of
-    :class:`~frontier_marl.config.EnvConfig` / ``ObservationConfig`` / ``RewardConfig`` as a
-    flat keyword (``config=EnvConfig(...)`` also works). Every value is validated at
-    construction.
+    **Arguments.** ``preset`` (``thesis-20x20``, ``thesis-30x30``, ``rooms-32``),
+    ``render_mode``, ``info`` (``mask``, ``minimal``, ``full``, ``debug``), ``obs_layout``
+    (``classic`` or ``flat``), and any field of :class:`~frontier_marl.config.EnvConfig` /
+    ``ObservationConfig`` / ``RewardConfig`` as a flat keyword (``config=EnvConfig(...)`` also
+    works; ``max_cycles`` is PettingZoo's name for ``max_steps``). Every value is validated at
+    construction; an unknown keyword raises ``TypeError``.
 
-    **Info.** Per agent (:mod:`frontier_marl.envs.infos`): ``explored_fraction``,
-    ``coverage`` (of the reachable free region), ``new_cells``, ``action_mask``, ``slots`` (the
-    robot's typed slot table), ``path`` (cells occupied this step, start included),
-    ``target``, ``position``, ``travelled``, ``padding``, ``oscillation``, ``step``,
-    ``end_reason``; ``info="minimal"`` keeps only the scalars training needs and the mask. A
-    ``StepInfo`` dict whose deep copy is shallow (treat it as read-only).
+    **Info.** Per agent, numbers and fixed-shape arrays only (:mod:`frontier_marl.envs.infos`):
+    ``explored_fraction``, ``coverage`` (of the reachable free region), ``new_cells``,
+    ``action_mask``, ``slots`` (the robot's slot table, packed), ``target`` (-1: none),
+    ``position``, ``travelled``, ``padding``, ``oscillation``, ``step``, ``end_reason`` (a
+    code); ``info="minimal"`` keeps only the scalars training needs and the mask, ``"mask"``
+    the mask, ``"debug"`` adds ``path``. A ``StepInfo`` dict whose deep copy is shallow (treat
+    it as read-only).
 
-    **Version history.** v0: first release.
+    **Version history.** v1: numeric fixed-shape infos, the classic mask layout, ``TypeError``
+    for unknown keywords, ``max_cycles``. v0: first release.
     """
 
     metadata = {
-        "name": "frontier_explore_v0",
+        "name": "frontier_explore_v1",
         "render_modes": RENDER_MODES,
         "render_fps": 4,
         "is_parallelizable": True,
@@ -72,16 +80,18 @@ class FrontierParallelEnv(ParallelEnv):
         preset: str | None = "thesis-20x20",
         render_mode: str | None = None,
         info: str = "full",
+        obs_layout: str = "classic",
         **kwargs: Any,
     ) -> None:
         self._renderer = Renderer(render_mode, self.metadata["render_fps"])
         self._info_level = check_info_level(info)
-        self.config: EnvConfig = make_config(preset, **kwargs)
+        self.config: EnvConfig = adapter_config(type(self).__name__, preset, kwargs)
         self.render_mode = render_mode
         self._mdp = ExplorationMDP(self.config)
         self.possible_agents = [f"robot_{i}" for i in range(self.config.n_agents)]
         self.agents: list[str] = []
-        self._obs_space = self._mdp.encoder.space
+        self.layout = ObservationLayout(self._mdp.encoder.space, obs_layout)
+        self._obs_space = self.layout.space
         self._act_space = spaces.Discrete(self.config.n_slots)
         self.observation_spaces = dict.fromkeys(self.possible_agents, self._obs_space)
         self.action_spaces = dict.fromkeys(self.possible_agents, self._act_space)
@@ -112,7 +122,7 @@ class FrontierParallelEnv(ParallelEnv):
         if seed is not None or self._rng is None:
             self._rng = np.random.default_rng(seed)
             self._act_space.seed(None if seed is None else seed + 1)
-        observations = self._mdp.reset(self._rng)
+        observations = map(self.layout.wrap, self._mdp.reset(self._rng))
         infos = build_infos(self._mdp, None, self._info_level)
         self.agents = list(self.possible_agents)
         if self.render_mode == "human":
@@ -141,7 +151,7 @@ class FrontierParallelEnv(ParallelEnv):
             )
         agents = self.agents
         result = self._mdp.step([actions[agent] for agent in agents])
-        observations = dict(zip(agents, result.observations, strict=True))
+        observations = dict(zip(agents, map(self.layout.wrap, result.observations), strict=True))
         rewards = {agent: float(r) for agent, r in zip(agents, result.rewards, strict=True)}
         terminations = dict.fromkeys(agents, result.terminated)
         truncations = dict.fromkeys(agents, result.truncated)

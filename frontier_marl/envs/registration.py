@@ -1,11 +1,12 @@
 """Namespaced, versioned ids for Gymnasium and PettingZoo: one generic id (any preset through
 ``preset=``) and one id per preset, as Minigrid registers its variants. Bump the version when
-behaviour changes.
+behaviour changes (v1: numeric fixed-shape infos, the classic mask layout, ``TypeError`` for
+unknown keywords; the v0 ids are gone, and Gymnasium names v1 when asked for them).
 
-    gymnasium.make("frontier_marl/FrontierExplore-Thesis30x30-v0")
-    gymnasium.make_vec("frontier_marl/FrontierExplore-v0", num_envs=64,
+    gymnasium.make("frontier_marl/FrontierExplore-Thesis30x30-v1")
+    gymnasium.make_vec("frontier_marl/FrontierExplore-v1", num_envs=64,
                        vectorization_mode="vector_entry_point")   # the batched vector env
-    pettingzoo.make("parallel", "frontier_marl/FrontierExplore-Rooms32-v0", n_agents=4)
+    pettingzoo.make("parallel", "frontier_marl/FrontierExplore-Rooms32-v1", n_agents=4)
 """
 
 from __future__ import annotations
@@ -15,14 +16,15 @@ import pettingzoo
 
 from frontier_marl.config import PRESETS
 
-GYM_ID = "frontier_marl/FrontierExplore-v0"
-PETTINGZOO_ID = "frontier_marl/FrontierExplore-v0"
+VERSION = 1
+GYM_ID = f"frontier_marl/FrontierExplore-v{VERSION}"
+PETTINGZOO_ID = GYM_ID
 
 
 def variant_id(preset: str) -> str:
-    """The id of a preset's variant, e.g. ``thesis-30x30`` -> ``...-Thesis30x30-v0``."""
+    """The id of a preset's variant, e.g. ``thesis-30x30`` -> ``...-Thesis30x30-v1``."""
     name = "".join(part.capitalize() for part in preset.split("-"))
-    return f"frontier_marl/FrontierExplore-{name}-v0"
+    return f"frontier_marl/FrontierExplore-{name}-v{VERSION}"
 
 
 #: Every registered id -> the env kwargs it stands for (the generic id: the default preset).

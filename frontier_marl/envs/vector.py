@@ -17,13 +17,23 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from frontier_marl.config import EnvConfig, make_config
+from frontier_marl.config import EnvConfig
+from frontier_marl.envs.infos import check_info_level
+from frontier_marl.envs.keywords import adapter_config
+from frontier_marl.envs.layout import ObservationLayout
 from frontier_marl.sim.batch_engine import BatchMDP
-from frontier_marl.sim.rewards import REASONS
 from frontier_marl.utils.checks import check_seed
 
-VECTOR_INFO_LEVELS = ("full", "minimal", "mask")
-_REASON_NAMES = np.array(REASONS, dtype=object)
+VECTOR_INFO_LEVELS = ("mask", "minimal", "full")
+#: The vector env's keywords beside the config's.
+VECTOR_KEYWORDS = (
+    "num_envs",
+    "preset",
+    "info",
+    "obs_layout",
+    "autoreset_mode",
+    "skip_forced_steps",
+)
 
 
 class FrontierVectorEnv(VectorEnv):
@@ -31,8 +41,8 @@ class FrontierVectorEnv(VectorEnv):
 
     **Actions.** An integer array of N x K slot indices, each in ``[0, n_slots)``.
 
-    **Observations.** The single env's layout with a leading N x K axis (a dict of such
-    arrays for ``Dict`` layouts); fresh arrays every step.
+    **Observations.** The single env's layout (``obs_layout``, classic by default) with a
+    leading N x K axis (a dict of such arrays for ``Dict`` layouts); fresh arrays every step.
 
     **Autoreset.** Gymnasium's modes: ``next-step`` (the default; the step after an episode's
     end resets that world, with reward 0 and no end flags) or ``same-step`` (the world resets
@@ -41,8 +51,8 @@ class FrontierVectorEnv(VectorEnv):
     **Infos** (arrays with a leading N x K axis and Gymnasium's ``_key`` masks), by ``info``
     level: ``mask``: ``action_mask`` (N x K, n_slots) only; ``minimal`` (the default) adds
     ``explored_fraction``, ``coverage``, ``new_cells``, ``travelled``, ``step`` and
-    ``end_reason``; ``full`` adds ``position``, ``target`` (row -1: none), ``padding`` and
-    ``oscillation``.
+    ``end_reason`` (int codes, :data:`~frontier_marl.envs.infos.END_REASONS`); ``full`` adds
+    ``position``, ``target`` (row -1: none), ``padding`` and ``oscillation``.
 
     **Forced steps.** With ``skip_forced_steps=True`` a step returns only when a decision is
     due: after the actions are applied, every world whose robots each have a single valid slot
@@ -51,8 +61,8 @@ class FrontierVectorEnv(VectorEnv):
     last one. The robots walk exactly as a policy choosing the only valid slot would (a
     semi-MDP view of the same episodes, for training).
 
-    **Arguments.** ``num_envs`` (worlds, >= 1), ``preset``, ``info``, ``autoreset_mode``,
-    ``skip_forced_steps``, and every keyword of
+    **Arguments.** ``num_envs`` (worlds, >= 1), ``preset``, ``info``, ``obs_layout``,
+    ``autoreset_mode``, ``skip_forced_steps``, and every keyword of
     :class:`~frontier_marl.envs.parallel.FrontierParallelEnv`.
     """
 
@@ -65,12 +75,12 @@ class FrontierVectorEnv(VectorEnv):
         info: str = "minimal",
         autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
         skip_forced_steps: bool = False,
+        obs_layout: str = "classic",
         **kwargs: Any,
     ) -> None:
         if not isinstance(skip_forced_steps, bool):
             raise ValueError(f"skip_forced_steps must be true or false, got {skip_forced_steps!r}")
-        if info not in VECTOR_INFO_LEVELS:
-            raise ValueError(f"info must be one of {list(VECTOR_INFO_LEVELS)}, got {info!r}")
+        check_info_level(info, VECTOR_INFO_LEVELS)
         modes = {mode.value: mode for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)}
         mode = autoreset_mode if isinstance(autoreset_mode, AutoresetMode) else None
         if mode is None and isinstance(autoreset_mode, str):
@@ -82,7 +92,8 @@ class FrontierVectorEnv(VectorEnv):
                 "autoreset_mode must be 'next-step' or 'same-step' (AutoresetMode.NEXT_STEP or "
                 f"SAME_STEP), got {autoreset_mode!r}"
             )
-        self.config: EnvConfig = make_config(preset, **kwargs)
+        owner = type(self).__name__
+        self.config: EnvConfig = adapter_config(owner, preset, kwargs, VECTOR_KEYWORDS)
         self.mdp = BatchMDP(self.config, num_envs)
         self.autoreset_mode = mode
         self.metadata = {**self.metadata, "autoreset_mode": mode}
@@ -90,7 +101,8 @@ class FrontierVectorEnv(VectorEnv):
         self.skip_forced_steps = skip_forced_steps
         self.n_worlds, self.n_agents = self.mdp.n_worlds, self.mdp.n_agents
         self.num_envs = self.n_worlds * self.n_agents
-        self.single_observation_space = self.mdp.encoder.space
+        self.layout = ObservationLayout(self.mdp.encoder.space, obs_layout)
+        self.single_observation_space = self.layout.space
         self.single_action_space = spaces.Discrete(self.config.n_slots)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -187,9 +199,10 @@ class FrontierVectorEnv(VectorEnv):
     def _observations(self) -> Any:
         batch = self.mdp.observations()
         if isinstance(batch, dict):
-            return {
-                key: value.reshape(self.num_envs, *value.shape[2:]) for key, value in batch.items()
-            }
+            n = self.num_envs
+            return self.layout.wrap(
+                {key: value.reshape(n, *value.shape[2:]) for key, value in batch.items()}
+            )
         return batch.reshape(self.num_envs, *batch.shape[2:])
 
     def _final(self, observations: Any, ended: np.ndarray) -> dict[str, Any]:
@@ -230,7 +243,7 @@ class FrontierVectorEnv(VectorEnv):
                 new_cells=mdp.new_cells.reshape(-1).copy(),
                 travelled=mdp.worlds.travelled.reshape(-1).copy(),
                 step=np.repeat(mdp.steps, k),
-                end_reason=np.repeat(_REASON_NAMES[reason], k),
+                end_reason=np.repeat(reason.astype(np.int64), k),
             )
         if self.info_level == "full":
             infos.update(

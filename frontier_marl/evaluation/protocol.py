@@ -59,6 +59,7 @@ from frontier_marl.evaluation.records import (
     level_key,
 )
 from frontier_marl.policies.base import Policy
+from frontier_marl.sim.rewards import reason_name
 
 # --------------------------------------------------------------------------- env adapters
 
@@ -173,7 +174,7 @@ def run_episode(
         reward=float(np.mean(robot_rewards)),
         robot_rewards=robot_rewards,
         steps=steps,
-        end_reason=str(last.get("end_reason", "")) if done else "max_steps",
+        end_reason=reason_name(last.get("end_reason", 0)) if done else "max_steps",
         travelled=travelled[-1],
         coverage=coverage[-1],
         explored_fraction=float(last.get("explored_fraction", float("nan"))),

@@ -18,12 +18,14 @@ from collections import Counter
 from pathlib import Path
 
 from frontier_marl.envs.gym_env import FrontierExploreEnv
+from frontier_marl.envs.infos import reason_name, slot_table
 from frontier_marl.policies.models import PRETRAINED, load_model, pretrained_model_dir
 
 
 def diagnose(model_dir: Path, episodes: int) -> dict[str, float]:
     loaded = load_model(model_dir / "model.zip")
-    env = FrontierExploreEnv(**json.loads((model_dir / "model.json").read_text())["env_config"])
+    env_config = json.loads((model_dir / "model.json").read_text())["env_config"]
+    env = FrontierExploreEnv(obs_layout="flat", **env_config)  # the model's own layout
     window = env.config.reward.no_progress_limit
     counts: Counter[str] = Counter()
     for seed in range(episodes):
@@ -33,13 +35,15 @@ def diagnose(model_dir: Path, episodes: int) -> dict[str, float]:
         while not done:
             action, _ = loaded.model.predict(obs, deterministic=True)
             slot = int(action)
-            chosen = next((c["target"] for c in info["slots"].rows() if c["slot"] == slot), None)
+            rows = slot_table(info).rows()
+            chosen = next((c["target"] for c in rows if c["slot"] == slot), None)
             obs, _, terminated, truncated, info = env.step(slot)
-            still_live = chosen in {c["target"] for c in info["slots"].rows()}
+            still_live = chosen in {c["target"] for c in slot_table(info).rows()}
             history.append((chosen, still_live))
             done = terminated or truncated
-        counts[f"end: {info['end_reason']}"] += 1
-        if "no_progress" in info["end_reason"]:
+        reason = reason_name(info["end_reason"])
+        counts[f"end: {reason}"] += 1
+        if "no_progress" in reason:
             stuck = history[-window:]
             counts["stuck episodes"] += 1
             counts["stuck decisions"] += len(stuck)

@@ -25,6 +25,8 @@ from typing import Any
 from frontier_marl.core.example_maps import resolve_map
 from frontier_marl.envs import FrontierParallelEnv
 from frontier_marl.policies import make_policy
+from frontier_marl.policies.base import slot_table, target_cell
+from frontier_marl.sim.rewards import reason_name
 from frontier_marl.utils.progress import progress_bar
 from frontier_marl.utils.set_options import parse_set_options
 
@@ -44,15 +46,16 @@ def stuck_episode(
     while env.agents:
         info = infos["robot_0"]
         action = policy.act_team(observations, infos)["robot_0"]
-        table = info["slots"]
+        table = slot_table(info)
         target = tuple(table.target[action].tolist()) if action < table.live else None
         offered = {tuple(t) for t in table.target[: table.live].tolist()}
+        previous = target_cell(info["target"])
         history.append(
             {
-                "position": info["position"],
+                "position": tuple(info["position"].tolist()),
                 "target": target,
-                "previous": info["target"],
-                "previous_offered": info["target"] in offered,
+                "previous": previous,
+                "previous_offered": previous in offered,
                 "distance_rank": int((table.distance[: table.live] < table.distance[action]).sum())
                 if target
                 else None,
@@ -65,7 +68,7 @@ def stuck_episode(
         )
         observations, _, _, _, infos = env.step({"robot_0": action})
     last = next(iter(infos.values()))
-    reason = last["end_reason"]
+    reason = reason_name(last["end_reason"])
     if not any(cause in reason for cause in STUCK):
         return None
     window = history[-env.config.reward.no_progress_limit :]

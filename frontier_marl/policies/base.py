@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from frontier_marl.core.slots import SlotTable
+from frontier_marl.envs.infos import slot_table
+from frontier_marl.envs.layout import ObservationLayout
 
 Info = Mapping[str, Any]
 
@@ -171,7 +172,7 @@ class CycleWatch:
 
 def previous_target_slot(info: Info) -> int | None:
     """The slot offering the target the robot headed for in its last step, if any."""
-    previous = info.get("target")
+    previous = target_cell(info.get("target"))
     if previous is None:
         return None
     table = slot_table(info)
@@ -181,13 +182,12 @@ def previous_target_slot(info: Info) -> int | None:
     return None
 
 
-def slot_table(info: Info) -> SlotTable:
-    try:
-        return info["slots"]
-    except (KeyError, TypeError) as exc:
-        raise ValueError(
-            "info must hold the robot's 'slots' table (the env's step info with info='full')"
-        ) from exc
+def target_cell(target: Any) -> tuple[int, int] | None:
+    """An info's ``target`` (row -1: none; ``None`` and tuples taken too) as a cell or
+    ``None``."""
+    if target is None or int(target[0]) < 0:
+        return None
+    return int(target[0]), int(target[1])
 
 
 def first_by(*keys: np.ndarray) -> int:
@@ -211,7 +211,9 @@ class ModelPolicy(Policy):
     model whose ``predict`` takes ``action_masks`` (sb3-contrib's ``MaskablePPO``) gets the
     env's action mask (``info["action_mask"]``). A deterministic model whose policy masks
     invalid slots itself (``policy.masks_invalid_slots``: the slot scorers) is not asked when
-    one slot is valid (a commitment, the last cluster): it would take that slot anyway."""
+    one slot is valid (a commitment, the last cluster): it would take that slot anyway. An
+    observation in the classic layout (``{"observation", "action_mask"}``) is turned back into
+    the flat layout of the model's observation space first."""
 
     def __init__(self, model: Any, name: str = "model", deterministic: bool = True) -> None:
         if not hasattr(model, "predict"):
@@ -220,6 +222,8 @@ class ModelPolicy(Policy):
         self.name = name
         self.deterministic = deterministic
         self.takes_masks = "action_masks" in inspect.signature(model.predict).parameters
+        space = getattr(model, "observation_space", None)
+        self.layout = None if space is None else ObservationLayout(space, "flat")
         masks_itself = getattr(getattr(model, "policy", None), "masks_invalid_slots", False)
         self.skips_forced = deterministic and masks_itself is True
 
@@ -231,6 +235,8 @@ class ModelPolicy(Policy):
         masks = {}
         if self.takes_masks and "action_mask" in info:
             masks["action_masks"] = np.asarray(info["action_mask"], dtype=bool)
+        if self.layout is not None:
+            obs = self.layout.unwrap(obs)  # a model takes the flat layout it was trained on
         action, _ = self.model.predict(obs, deterministic=self.deterministic, **masks)
         return _as_slot(action)
 

@@ -21,9 +21,11 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.envs.layout import ObservationLayout
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.policies.metadata import (
     check_compatible,
+    describe_space,
     env_config_from_metadata,
     load_metadata,
 )
@@ -170,12 +172,18 @@ def load_model(path: str | Path, device: str = "cpu") -> LoadedModel:
 
 
 def check_model_env(loaded: LoadedModel, cfg: EnvConfig) -> None:
-    """Raise ``ModelEnvMismatchError`` if the model cannot act in an env built from ``cfg``."""
-    env = FrontierParallelEnv(config=cfg)
+    """Raise ``ModelEnvMismatchError`` if the model cannot act in an env built from ``cfg``
+    (in the flat layout the project's models are trained on, or a model trained on the classic
+    layout in that one)."""
+    env = FrontierParallelEnv(config=cfg, obs_layout="flat")
     agent = env.possible_agents[0]
+    space = env.observation_space(agent)
+    classic = ObservationLayout(space, "classic").space
+    if describe_space(loaded.model.observation_space) == describe_space(classic):
+        space = classic
     check_compatible(
         cfg,
-        env.observation_space(agent),
+        space,
         env.action_space(agent),
         loaded.model.observation_space,
         loaded.model.action_space,

@@ -192,6 +192,11 @@ class ExplorationMDP:
             self._tables = [arrays.table(agent) for agent in range(self.cfg.n_agents)]
         return list(self._tables)
 
+    def slot_arrays(self) -> SlotArrays:
+        """The robots' slots as ``(N, ...)`` arrays (those of :meth:`slot_tables`)."""
+        assert self._slot_arrays is not None
+        return self._slot_arrays
+
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None

@@ -119,6 +119,7 @@ class StepOutcome:
     terminated: bool
     truncated: bool
     reason: str  # "threshold" | "no_frontier" | truncation causes joined by "+" | ""
+    code: int = 0  # the reason's code: REASONS[code] == reason
 
 
 # End reasons as bits of an int code (:func:`batch_outcome`); :data:`REASONS` decodes them.
@@ -132,6 +133,13 @@ REASONS: tuple[str, ...] = tuple(
     else "+".join(name for bit, name in _REASON_NAMES if code & bit)
     for code in range(32)
 )
+
+
+def reason_name(code: int | str) -> str:
+    """The name of an end-reason code (``REASONS[code]``; a name is returned as it is)."""
+    if isinstance(code, str):
+        return code
+    return REASONS[int(code)]
 
 
 @dataclass(slots=True)
@@ -301,4 +309,5 @@ def first_outcome(outcome: BatchOutcome) -> StepOutcome:
         bool(outcome.terminated[0]),
         bool(outcome.truncated[0]),
         REASONS[int(outcome.reason[0])],
+        int(outcome.reason[0]),
     )

@@ -54,7 +54,11 @@ class BatchedVecEnv(MaskedVecEnv):
         bootstrap_truncations: bool = True,
     ) -> None:
         self.env = FrontierVectorEnv(
-            num_envs=n_envs, autoreset_mode="same-step", info="mask", **env_kwargs
+            num_envs=n_envs,
+            autoreset_mode="same-step",
+            info="mask",
+            obs_layout="flat",  # SB3 takes no nested Dict; saved models record this layout
+            **env_kwargs,
         )
         self.mark_truncations = bootstrap_truncations
         super().__init__(

@@ -37,6 +37,7 @@ from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.metadata import build_metadata, save_metadata
 from frontier_marl.policies.models import pretrained_model_dir
 from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
+from frontier_marl.sim.rewards import THRESHOLD
 from frontier_marl.training.batched_vec_env import make_batched_vec_env
 from frontier_marl.training.family_validation import FAILURE, FamilyValidator
 from frontier_marl.training.plots import plot_family_validation
@@ -74,7 +75,9 @@ def play_scorer(
     observation, e.g. the belief maps); the valid slot of highest score is taken."""
     if cfg.n_agents != 1:
         raise ValueError("the cross-entropy method trains one robot (train.agents = [1])")
-    env = FrontierVectorEnv(num_envs=len(seeds), config=cfg, skip_forced_steps=True)
+    env = FrontierVectorEnv(
+        num_envs=len(seeds), config=cfg, skip_forced_steps=True, obs_layout="flat"
+    )
     observations, _ = env.reset(seed=list(seeds))
     t99 = np.full(len(seeds), np.nan)
     ended = np.zeros(len(seeds), dtype=bool)
@@ -85,7 +88,7 @@ def play_scorer(
         observations, _, terminated, truncated, info = env.step(scores.argmax(axis=1))
         decisions += int((~ended).sum())
         new = (terminated | truncated) & ~ended
-        reached = new & (info["end_reason"] == "threshold")
+        reached = new & (info["end_reason"] == THRESHOLD)
         t99[reached] = info["travelled"][reached]
         ended |= new
     env.close()

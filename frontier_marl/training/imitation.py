@@ -73,8 +73,8 @@ def play(
     rng: np.random.Generator,
 ) -> int:
     """One labelled episode of one robot in ``env`` (a FrontierParallelEnv with the explorer
-    observation); returns the cells travelled. A decision follows the teacher with
-    probability ``follow_teacher`` (always without a ``student``)."""
+    observation in the flat layout); returns the cells travelled. A decision follows the
+    teacher with probability ``follow_teacher`` (always without a ``student``)."""
     observations, _ = env.reset(seed=seed)
     height, width = env.config.shape
     done = False
@@ -111,7 +111,7 @@ def collect(
 ) -> None:
     """Episodes ``seeds[i]`` of config ``configs[i]`` into ``data`` (see :func:`play`)."""
     for cfg, family_seeds in zip(configs, seeds, strict=True):
-        env = FrontierParallelEnv(config=cfg)
+        env = FrontierParallelEnv(config=cfg, obs_layout="flat")
         try:
             for seed in family_seeds:
                 play(env, int(seed), data, student, follow_teacher, rng)

@@ -32,6 +32,7 @@ from pettingzoo.utils.wrappers import BaseParallelWrapper
 from stable_baselines3.common.vec_env import VecMonitor
 
 from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.sim.rewards import reason_name
 
 TRUNCATED_KEY = "TimeLimit.truncated"
 END_REASON_KEY = "episode_end_reason"
@@ -41,9 +42,10 @@ class TimeLimitInfo(BaseParallelWrapper):
     """Marks the last step of an episode in each agent's info, in keys that survive SuperSuit.
 
     * ``info["TimeLimit.truncated"] = True`` when the episode was truncated, not terminated;
-    * ``info["episode_end_reason"]``: the env's ``end_reason`` (``threshold``, ``step_limit``,
-      ...). SuperSuit's ``MarkovVectorEnv`` merges the next episode's reset info over the last
-      step's info, so the env's own ``end_reason``/``step`` keys read ``""``/``0`` there.
+    * ``info["episode_end_reason"]``: the name of the env's ``end_reason`` code (``threshold``,
+      ``step_limit``, ...). SuperSuit's ``MarkovVectorEnv`` merges the next episode's reset
+      info over the last step's info, so the env's own ``end_reason``/``step`` keys read
+      ``0`` there.
 
     With ``mark_truncations=False`` the first key is left out, so SB3 treats truncations as
     terminal: SuperSuit's own behaviour, kept as an option for experiments (the thesis's
@@ -60,7 +62,7 @@ class TimeLimitInfo(BaseParallelWrapper):
         observations, rewards, terminations, truncations, infos = self.env.step(actions)
         if any(truncations.values()) or any(terminations.values()):
             for agent, info in infos.items():
-                info[END_REASON_KEY] = info.get("end_reason", "")
+                info[END_REASON_KEY] = reason_name(info.get("end_reason", 0))
                 if self.mark_truncations and truncations[agent] and not terminations[agent]:
                     info[TRUNCATED_KEY] = True
         return observations, rewards, terminations, truncations, infos
@@ -68,8 +70,10 @@ class TimeLimitInfo(BaseParallelWrapper):
 
 def make_parallel_env(env_kwargs: dict[str, Any], mark_truncations: bool = True) -> TimeLimitInfo:
     """The wrapped ParallelEnv for ``env_kwargs`` (flat keywords of ``make_config``), with the
-    minimal infos (training reads only the end reason, the mask and the scalars)."""
-    return TimeLimitInfo(FrontierParallelEnv(info="minimal", **env_kwargs), mark_truncations)
+    minimal infos (training reads only the end reason, the mask and the scalars) and the flat
+    observation layout (SB3 takes no nested ``Dict``; saved models record this layout)."""
+    env = FrontierParallelEnv(info="minimal", obs_layout="flat", **env_kwargs)
+    return TimeLimitInfo(env, mark_truncations)
 
 
 def make_vec_env(

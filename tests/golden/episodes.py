@@ -4,6 +4,11 @@ Each case plays whole episodes of one env configuration with one heuristic and h
 observation, reward, episode flag and info value, one digest per stream, so a change shows
 which stream moved. ``python tests/golden/episodes.py`` rewrites ``episodes.json`` (only do
 that for a deliberate change of behaviour, and say so in the commit).
+
+Rewritten for the env's v1 (issue 33): the ``target``, ``position`` and ``end_reason`` infos
+became fixed-shape numbers (arrays, a code) and the observations with an action mask took the
+classic ``{"observation", "action_mask"}`` layout, so those streams' digests changed and no
+other did; translated back to v0's forms, v1 replayed every v0 digest.
 """
 
 from __future__ import annotations
@@ -144,7 +149,9 @@ def slot_rows(info: Mapping[str, Any]) -> list[tuple[Any, ...]]:
     """The live slots of one robot's info: (slot, cluster, centroid, target, size, gain,
     distance) each, with centroid and target as (row, col) tuples. (Before the typed step
     these were the info's ``clusters`` dicts; the rows are the same.)"""
-    table = info["slots"]
+    from frontier_marl.envs.infos import slot_table
+
+    table = slot_table(info)
     return [
         (
             slot,
@@ -164,7 +171,7 @@ def play(kwargs: Mapping[str, Any], policy_name: str, seed: int) -> dict[str, An
     import frontier_marl
     from frontier_marl.policies import make_policy
 
-    env = frontier_marl.parallel_env(**kwargs)
+    env = frontier_marl.parallel_env(info="debug", **kwargs)  # debug: with the path
     policy = make_policy(policy_name, seed)
     policy.attach(env)
     streams = {
@@ -199,7 +206,7 @@ def play(kwargs: Mapping[str, Any], policy_name: str, seed: int) -> dict[str, An
     return {
         "steps": steps,
         "return": round(total, 9),
-        "end_reason": last["end_reason"],
+        "end_reason": frontier_marl.reason_name(last["end_reason"]),
         "digests": {name: h.hexdigest()[:16] for name, h in streams.items()},
     }
 

@@ -100,7 +100,7 @@ def record_episode(
                 returns[agent] += reward
             steps += 1
             frames.append(render_frame(env, cell_px))
-            reason = next(iter(infos.values()))["end_reason"]
+            reason = frontier_marl.reason_name(next(iter(infos.values()))["end_reason"])
         if env.agents:
             reason = "max_steps"
     finally:

@@ -45,7 +45,7 @@ from frontier_marl.evaluation.benchmark.families import (
 from frontier_marl.evaluation.benchmark.stats import compare, summary_row
 from frontier_marl.evaluation.protocol import evaluate
 from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
-from frontier_marl.policies.base import ModelPolicy, Policy
+from frontier_marl.policies.base import ModelPolicy, Policy, slot_table
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.policies.metadata import ModelEnvMismatchError
 from frontier_marl.policies.models import PRETRAINED, check_model_env, load_model
@@ -158,8 +158,10 @@ class _SlotWatch(Policy):
 
     def act_team(self, observations: Any, infos: Mapping[str, Any]) -> dict[str, int]:
         for info in infos.values():
-            table = info.get("slots")
-            if table is not None and table.live == len(table.valid):
+            if "slots" not in info:
+                continue
+            table = slot_table(info)
+            if table.live == len(table.valid):
                 self.saturated += 1
         return self.policy.act_team(observations, infos)
 

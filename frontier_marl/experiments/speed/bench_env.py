@@ -29,6 +29,7 @@ import gymnasium as gym
 import numpy as np
 
 import frontier_marl
+from frontier_marl.envs.infos import slot_table
 
 SETTINGS: list[tuple[str, dict[str, Any]]] = [
     ("thesis-20x20, 1 robot", {"preset": "thesis-20x20"}),
@@ -72,7 +73,7 @@ def explore_bench_settings(map_file: Path) -> list[tuple[str, dict[str, Any]]]:
 
 
 def nearest(info: dict[str, Any], rng: np.random.Generator) -> int:
-    table = info["slots"]
+    table = slot_table(info)
     return int(np.argmin(table.distance[: table.live])) if table.live else 0
 
 
