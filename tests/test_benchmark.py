@@ -267,7 +267,7 @@ def test_cli_smoke_with_a_family_and_a_loaded_map(tmp_path, capsys):
     assert "nearest-path" in text and "map:rooms-32" in text and "best" in text
     data = json.loads(out_json.read_text())
     rows = data["rows"]
-    assert len(rows) == 8  # 2 families x 4 heuristics
+    assert len(rows) == 10  # 2 families x 5 heuristics (frontier-rule among them)
     keys = ("policy", "family", "agents", "episodes", "success", "t99_mean", "t99_std")
     for row in rows:
         for key in (*keys, "t90_mean", "makespan99_mean", "per_episode"):

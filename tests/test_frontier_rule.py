@@ -36,7 +36,7 @@ def test_the_rule_needs_its_layout_and_its_env() -> None:
     with pytest.raises(RuntimeError, match="attach"):
         rule.act({"slots": np.zeros((12, 14)), "action_mask": np.ones(12)}, {})
     rule.attach(frontier_marl.parallel_env(**FRONTIER_RULE_SETTINGS))
-    with pytest.raises(ValueError, match="explorer observation"):
+    with pytest.raises(ValueError, match="the explorer observation"):
         rule.act(np.zeros(10), {})
     with pytest.raises(ValueError, match="needs features = 'explorer'"):
         rule.attach(frontier_marl.parallel_env())

@@ -3,6 +3,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 import torch
@@ -156,3 +159,15 @@ def test_the_rollout_probe_scores_both_oracles_on_validation_episodes(tmp_path) 
     assert all(row["seeds"] == [800_000, 800_001] and row["success"] == 2 for row in rows)
     with pytest.raises(SystemExit):
         probe(["--families", "rooms-128"])
+
+
+def test_the_headroom_probe_scores_both_oracles_in_frontier_rules_env(tmp_path: Path) -> None:
+    from frontier_marl.experiments.explorer_studies import headroom
+
+    out = tmp_path / "headroom.json"
+    argv = ["--families", "random-20", "--episodes", "1", "--no-progress", "--json", str(out)]
+    assert headroom.main(argv) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["policy"] for row in rows] == ["frontier-rule", "oracle-np-12", "oracle-rule-12"]
+    assert {row["config"]["n_slots"] for row in rows} == {12}  # the same slots for all three
+    assert all(row["success"] == 1 for row in rows)

@@ -20,6 +20,7 @@ from frontier_marl.policies import (
     RandomValid,
     make_policy,
 )
+from frontier_marl.policies.registry import env_settings
 from tests.helpers import info_with, live_slot
 from tests.oracles import bfs
 
@@ -61,7 +62,12 @@ def test_greedy_gain_ties_go_to_the_nearest_then_the_lowest_slot():
     assert GreedyGain().act(None, info) == 1
 
 
-@pytest.mark.parametrize("name", list(POLICIES))
+#: The heuristics that read the slot table alone (frontier-rule reads its own observation:
+#: tests/test_frontier_rule.py).
+SLOT_TABLE_POLICIES = [name for name in POLICIES if not env_settings(name)]
+
+
+@pytest.mark.parametrize("name", SLOT_TABLE_POLICIES)
 def test_no_live_cluster_gives_slot_0(name):
     policy = make_policy(name, seed=0)
     assert policy.act(None, info_with([])) == 0
@@ -175,8 +181,9 @@ def test_callable_and_model_adapters():
 @pytest.mark.parametrize("name", list(POLICIES))
 def test_heuristics_choose_valid_slots_in_a_team(name):
     env = frontier_marl.parallel_env(
-        height=10, width=10, n_agents=2, obstacle_prob=0.15, explore_threshold=0.8
-    )
+        height=10, width=10, n_agents=2, obstacle_prob=0.15, explore_threshold=0.8,
+        **env_settings(name),
+    )  # fmt: skip
     policy = make_policy(name, seed=1)
     policy.attach(env)
     obs, infos = env.reset(seed=1)

@@ -27,7 +27,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from frontier_marl.policies.base import Info, Policy
-from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.policies.linear_scorer import explorer_slots, feature_names, weight_vector
 
 #: The weight of each explorer feature (lengths in units of 32 cells, see the features).
 FRONTIER_RULE_WEIGHTS: dict[str, float] = {
@@ -88,13 +88,9 @@ class FrontierRule(Policy):
     def act(self, obs: Any, info: Info) -> int:
         if self._vector is None:
             raise RuntimeError("frontier-rule needs attach(env) before it acts")
-        if not isinstance(obs, dict) or "slots" not in obs:
-            raise ValueError(
-                "frontier-rule reads the explorer observation (features='explorer'); run it "
-                "with its env settings, frontier_marl.policies.frontier_rule.FRONTIER_RULE_SETTINGS"
-            )
-        scores = obs["slots"].astype(np.float32) @ self._vector
-        valid = np.asarray(obs["action_mask"], dtype=bool)
+        slots, mask = explorer_slots(obs)
+        scores = slots.astype(np.float32) @ self._vector
+        valid = mask.astype(bool)
         if not valid.any():
             return 0
         return int(np.argmax(np.where(valid, scores, -np.inf)))

@@ -9,6 +9,7 @@ vector and takes the best slot (the ``explorer`` trained by CEM,
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -31,3 +32,17 @@ def weight_vector(weights: Mapping[str, float], names: list[str], what: str) -> 
     if unknown:
         raise ValueError(f"{what} names unknown feature(s) {sorted(unknown)}; features: {names}")
     return np.array([float(weights.get(name, 0.0)) for name in names])
+
+
+def explorer_slots(obs: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The (n_slots, F) slot features and (n_slots,) action mask of one explorer observation,
+    in either layout (``{"slots", "action_mask"}`` or the classic ``{"observation",
+    "action_mask"}``); ValueError for any other observation."""
+    if isinstance(obs, Mapping) and "action_mask" in obs:
+        slots = obs.get("slots", obs.get("observation"))
+        if slots is not None and np.ndim(slots) == 2:
+            return np.asarray(slots), np.asarray(obs["action_mask"])
+    raise ValueError(
+        "expected the explorer observation (features='explorer'): the policy runs with the "
+        "observation settings of frontier_marl.policies.frontier_rule.FRONTIER_RULE_SETTINGS"
+    )

@@ -1,0 +1,113 @@
+"""The map-aware learned chooser: among the valid slots, the one of lowest predicted regret.
+
+A :class:`MapExplorer` builds each valid slot's map crops from the env's belief
+(:mod:`~frontier_marl.policies.map_crops`), reads its explorer slot features from the
+observation, and asks a :class:`~frontier_marl.policies.networks.map_scorer.MapScorer` for
+each candidate's relative regret (its expected cost-to-go over the cheapest candidate's, as
+learned from true-map rollouts, :mod:`frontier_marl.training.cost_to_go`). It runs with the
+observation settings of ``frontier-rule`` (:data:`MAP_EXPLORER_SETTINGS`: the same 12 slots
+and features) and keeps a target until it reaches it.
+
+Saved as a folder: ``model.pt`` (the scorer's weights) and ``model.json`` (``"format":
+"map-scorer"``, the scorer's shape, the env settings it reads, how it was trained). Loading
+needs torch and no training library.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from frontier_marl.policies.base import Info, Policy
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
+from frontier_marl.policies.linear_scorer import explorer_slots, feature_names
+from frontier_marl.policies.map_crops import crop_shape, slot_crops
+from frontier_marl.policies.networks.map_scorer import MapScorer
+
+FORMAT = "map-scorer"
+MODEL_FILE = "model.pt"
+METADATA_FILE = "model.json"
+MAP_EXPLORER_SETTINGS: dict[str, Any] = dict(FRONTIER_RULE_SETTINGS)
+
+
+def new_scorer(n_features: int, width: int = 32) -> MapScorer:
+    channels, side, _ = crop_shape()
+    return MapScorer(channels, side, n_features, width)
+
+
+def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) -> None:
+    """``folder/model.pt`` and ``folder/model.json`` (``metadata`` plus the scorer's shape)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    torch.save(model.state_dict(), folder / MODEL_FILE)
+    shape = {"n_features": model.feature_mean.numel(), "width": model.conv[0].out_channels}
+    record = {"format": FORMAT, "scorer": shape, "env_settings": MAP_EXPLORER_SETTINGS}
+    (folder / METADATA_FILE).write_text(json.dumps({**record, **metadata}, indent=2) + "\n")
+
+
+def is_map_explorer(folder: Path) -> bool:
+    """Whether ``folder`` holds a saved map explorer."""
+    path = Path(folder) / METADATA_FILE
+    if not path.is_file() or not (Path(folder) / MODEL_FILE).is_file():
+        return False
+    try:
+        return json.loads(path.read_text()).get("format") == FORMAT
+    except ValueError:
+        return False
+
+
+def load_scorer(folder: Path) -> tuple[MapScorer, dict[str, Any]]:
+    """The scorer saved in ``folder`` and its metadata; ValueError naming a damaged file."""
+    folder = Path(folder)
+    try:
+        metadata = json.loads((folder / METADATA_FILE).read_text())
+        shape = metadata["scorer"]
+        model = new_scorer(int(shape["n_features"]), int(shape["width"]))
+        model.load_state_dict(torch.load(folder / MODEL_FILE, map_location="cpu"))
+    except (OSError, ValueError, KeyError, RuntimeError) as error:
+        raise ValueError(f"cannot load the map explorer in {folder}: {error}") from error
+    model.eval()
+    return model, metadata
+
+
+class MapExplorer(Policy):
+    """The valid slot of lowest predicted regret; one robot (a team's robots would need
+    their own slot tables: not built yet)."""
+
+    deterministic = True
+
+    def __init__(self, model: MapScorer, name: str = "explorer") -> None:
+        self.model = model
+        self.name = name
+        self._env: Any = None
+
+    @classmethod
+    def load(cls, folder: Path, name: str = "explorer") -> MapExplorer:
+        model, _ = load_scorer(folder)
+        return cls(model, name)
+
+    def attach(self, env: Any) -> None:
+        expected = self.model.feature_mean.numel()
+        if len(feature_names(env.config)) != expected:
+            raise ValueError(
+                f"{self.name} reads {expected} slot features; the env gives "
+                f"{len(feature_names(env.config))}: run it with its env settings"
+            )
+        self._env = env
+
+    def act(self, obs: Any, info: Info) -> int:
+        if self._env is None:
+            raise RuntimeError(f"{self.name} needs attach(env) before it acts")
+        slots, mask = explorer_slots(obs)
+        valid = np.flatnonzero(mask > 0)
+        if len(valid) <= 1:
+            return int(valid[0]) if len(valid) else 0
+        crops = slot_crops(self._env, valid)
+        features = torch.as_tensor(slots[valid], dtype=torch.float32)[None]
+        mask = torch.ones((1, len(valid)), dtype=torch.bool)
+        with torch.no_grad():
+            regret = self.model(torch.as_tensor(crops)[None], features, mask)[0]
+        return int(valid[int(torch.argmin(regret))])

@@ -1,0 +1,153 @@
+"""Privileged targets for a map-aware chooser: each candidate's cost-to-go on the true map.
+
+At every real decision of an episode (two or more valid slots) the robot's world is cloned
+once per valid slot; each clone walks to that slot's target and a fixed base policy finishes
+the map (:func:`frontier_marl.policies.lookahead.lookahead_costs`). The cells travelled until
+the coverage level are the candidate's cost-to-go. A sample holds what the robot itself sees
+of each candidate (its map crops, :mod:`frontier_marl.policies.map_crops`, and its explorer
+slot features) and the candidates' costs; a scorer that regresses the costs from those inputs
+over many maps learns their expectation under the unknown part of the map.
+
+The episodes are played by a behaviour policy (``frontier-rule`` first, then the learner:
+DAgger, so the learner is trained on the states it visits itself); the labels do not depend on
+it. Samples are stored as arrays of fixed shapes (:class:`Samples`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.config import EnvConfig
+from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.policies.linear_scorer import explorer_slots
+from frontier_marl.policies.lookahead import RolloutBase, lookahead_costs
+from frontier_marl.policies.map_crops import crop_shape, slot_crops
+
+#: A behaviour: (observation, the decision's candidate inputs) -> the valid slot it takes.
+Behaviour = Callable[[dict[str, np.ndarray], "Candidates"], int]
+
+
+@dataclass
+class Candidates:
+    """The valid slots of one decision and what the robot sees of each."""
+
+    slots: np.ndarray  # int (M,): slot indices
+    crops: np.ndarray  # float32 (M, C, S, S)
+    features: np.ndarray  # float32 (M, F): the explorer slot features
+
+
+@dataclass
+class Samples:
+    """Labelled candidates, one row each; ``decision`` groups the rows of one decision."""
+
+    crops: np.ndarray = field(default_factory=lambda: np.zeros((0, *crop_shape()), np.uint8))
+    features: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), np.float32))
+    cost: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))
+    decision: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    family: np.ndarray = field(default_factory=lambda: np.zeros(0, "U16"))
+
+    def __len__(self) -> int:
+        return len(self.cost)
+
+    def save(self, path: Path) -> None:
+        np.savez_compressed(path, **{f.name: getattr(self, f.name) for f in fields(self)})
+
+    @classmethod
+    def load(cls, path: Path) -> Samples:
+        with np.load(path) as data:
+            return cls(**{f.name: data[f.name] for f in fields(cls)})
+
+    @classmethod
+    def join(cls, parts: Sequence[Samples]) -> Samples:
+        """One set of samples; decision numbers stay distinct across the parts."""
+        parts = [p for p in parts if len(p)]
+        if not parts:
+            return cls()
+        offsets = np.cumsum([0] + [int(p.decision.max()) + 1 for p in parts[:-1]])
+        return cls(
+            crops=np.concatenate([p.crops for p in parts]),
+            features=np.concatenate([p.features for p in parts]),
+            cost=np.concatenate([p.cost for p in parts]),
+            decision=np.concatenate([p.decision + o for p, o in zip(parts, offsets, strict=True)]),
+            family=np.concatenate([p.family for p in parts]),
+        )
+
+
+def decision_candidates(env: FrontierParallelEnv, obs: dict[str, np.ndarray]) -> Candidates:
+    """The valid slots of robot 0's decision in ``env`` (explorer observation ``obs``)."""
+    slots, mask = explorer_slots(obs)
+    valid = np.flatnonzero(mask > 0)
+    return Candidates(valid, slot_crops(env, valid), slots[valid].astype(np.float32))
+
+
+def label_episode(
+    cfg: EnvConfig,
+    seed: int,
+    behaviour: Behaviour,
+    base: RolloutBase | None = None,
+    family: str = "",
+) -> Samples:
+    """Play one episode (reset ``seed``) with ``behaviour`` and label every real decision's
+    candidates with their cost-to-go (``base`` finishing each clone, nearest-path by
+    default)."""
+    env = FrontierParallelEnv(config=cfg)
+    height, width = cfg.height, cfg.width
+    rows: list[tuple[Candidates, np.ndarray]] = []
+    observations, _ = env.reset(seed=seed)
+    while env.agents:
+        obs = observations["robot_0"]
+        _, mask = explorer_slots(obs)
+        action = int(np.argmax(mask))
+        if int(mask.sum()) > 1:
+            candidates = decision_candidates(env, obs)
+            world = env.world
+            targets = env.mdp.slot_tables()[0].target[candidates.slots]
+            costs = lookahead_costs(
+                world.batch,
+                world.index,
+                targets,
+                cfg.reward.explore_threshold,
+                4 * height * width,
+                base,
+            )
+            rows.append((candidates, costs.astype(np.float64)))
+            action = behaviour(obs, candidates)
+        observations, *_ = env.step({"robot_0": action})
+    env.close()
+    return _samples(rows, family)
+
+
+def _samples(rows: list[tuple[Candidates, np.ndarray]], family: str) -> Samples:
+    if not rows:
+        return Samples()
+    crops = np.concatenate([c.crops for c, _ in rows])
+    return Samples(
+        crops=np.round(crops * 255).astype(np.uint8),
+        features=np.concatenate([c.features for c, _ in rows]),
+        cost=np.concatenate([cost for _, cost in rows]),
+        decision=np.concatenate([np.full(len(cost), i) for i, (_, cost) in enumerate(rows)]),
+        family=np.full(len(crops), family, dtype="U16"),
+    )
+
+
+def relative_regret(cost: np.ndarray, decision: np.ndarray, cap: float = 1.0) -> np.ndarray:
+    """Per candidate, its cost over the cheapest of its decision's, minus 1, capped at
+    ``cap`` (a candidate twice as dear as the best is as bad as any worse one)."""
+    best = np.full(int(decision.max()) + 1, np.inf)
+    np.minimum.at(best, decision, cost)
+    cheapest = np.maximum(best[decision], 1.0)
+    return np.minimum(cost / cheapest - 1.0, cap)
+
+
+def first_choice_of(scores: Callable[[dict[str, np.ndarray], Candidates], np.ndarray]) -> Any:
+    """A behaviour taking the candidate of lowest ``scores`` (ties: the lower slot)."""
+
+    def behaviour(obs: dict[str, np.ndarray], candidates: Candidates) -> int:
+        return int(candidates.slots[int(np.argmin(scores(obs, candidates)))])
+
+    return behaviour

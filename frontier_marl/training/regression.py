@@ -1,0 +1,131 @@
+"""Fitting the map-aware scorer to the privileged costs (:mod:`~frontier_marl.training.cost_to_go`).
+
+The samples are grouped by decision into padded tensors (at most ``n_slots`` candidates, a
+mask for the rest). The target of each candidate is its relative regret
+(:func:`~frontier_marl.training.cost_to_go.relative_regret`); the loss is the mean squared
+error over the valid candidates. Each batch is seen in one of the eight symmetries of the
+square (the crops rotated or mirrored, the target's row and column offsets turned alike), so
+the scorer learns that a corridor going north is a corridor going east.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from frontier_marl.policies.networks.map_scorer import MapScorer
+from frontier_marl.training.cost_to_go import Samples, relative_regret
+
+#: Columns of the explorer features that are offsets on the grid: (row, col).
+OFFSET_COLUMNS = (2, 3)
+
+
+@dataclass
+class Decisions:
+    """Samples grouped by decision: ``crops`` uint8 (D, M, C, S, S), ``features`` float32
+    (D, M, F), ``regret`` float32 (D, M), ``mask`` bool (D, M)."""
+
+    crops: torch.Tensor
+    features: torch.Tensor
+    regret: torch.Tensor
+    mask: torch.Tensor
+
+    def __len__(self) -> int:
+        return len(self.mask)
+
+    def subset(self, rows: np.ndarray) -> Decisions:
+        index = torch.as_tensor(rows)
+        return Decisions(
+            self.crops[index], self.features[index], self.regret[index], self.mask[index]
+        )
+
+
+def group(samples: Samples, n_slots: int, cap: float = 1.0) -> Decisions:
+    """The decisions of ``samples`` as padded tensors of ``n_slots`` candidates."""
+    _, order, counts = np.unique(samples.decision, return_inverse=True, return_counts=True)
+    if counts.max() > n_slots:
+        raise ValueError(f"a decision has {counts.max()} candidates, more than {n_slots}")
+    rank = np.zeros(len(samples), dtype=np.int64)
+    for d in range(len(counts)):  # candidates keep their order within a decision
+        rank[order == d] = np.arange(counts[d])
+    shape = (len(counts), n_slots)
+    crops = np.zeros((*shape, *samples.crops.shape[1:]), dtype=np.uint8)
+    features = np.zeros((*shape, samples.features.shape[1]), dtype=np.float32)
+    regret = np.zeros(shape, dtype=np.float32)
+    mask = np.zeros(shape, dtype=bool)
+    crops[order, rank] = samples.crops
+    features[order, rank] = samples.features
+    regret[order, rank] = relative_regret(samples.cost, order, cap)
+    mask[order, rank] = True
+    return Decisions(*(torch.as_tensor(a) for a in (crops, features, regret, mask)))
+
+
+def symmetry(crops: torch.Tensor, features: torch.Tensor, k: int) -> tuple[torch.Tensor, ...]:
+    """The ``k``-th of the square's eight symmetries (``k // 2`` quarter turns, mirrored if
+    ``k`` is odd) applied to the crops' last two axes and to the offset features."""
+    row, col = OFFSET_COLUMNS
+    crops = torch.rot90(crops, k // 2, dims=(-2, -1))
+    features = features.clone()
+    for _ in range(k // 2):  # a quarter turn takes (row, col) offsets to (-col, row)
+        features[..., row], features[..., col] = -features[..., col], features[..., row].clone()
+    if k % 2:
+        crops = torch.flip(crops, dims=(-2,))
+        features[..., row] = -features[..., row]
+    return crops, features
+
+
+def fit(
+    model: MapScorer,
+    train: Decisions,
+    epochs: int,
+    batch_size: int = 64,
+    learning_rate: float = 1e-3,
+    seed: int = 0,
+    on_epoch: object = None,
+) -> list[float]:
+    """Adam on the masked squared error; returns the mean training loss of each epoch."""
+    generator = torch.Generator().manual_seed(seed)
+    optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate)
+    losses = []
+    for epoch in range(epochs):
+        order = torch.randperm(len(train), generator=generator)
+        total, batches = 0.0, 0
+        model.train()
+        for start in range(0, len(train), batch_size):
+            rows = order[start : start + batch_size]
+            k = int(torch.randint(8, (1,), generator=generator))
+            crops, features = symmetry(train.crops[rows].float() / 255.0, train.features[rows], k)
+            mask = train.mask[rows]
+            predicted = model(crops, features, mask)
+            loss = ((predicted - train.regret[rows])[mask] ** 2).mean()
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total, batches = total + float(loss), batches + 1
+        losses.append(total / max(batches, 1))
+        if callable(on_epoch):
+            on_epoch(epoch, losses[-1])
+    return losses
+
+
+@torch.no_grad()
+def predict(model: MapScorer, data: Decisions, batch_size: int = 256) -> torch.Tensor:
+    """(D, M) predicted regret (``inf`` on padding)."""
+    model.eval()
+    parts = [
+        model(
+            data.crops[start : start + batch_size].float() / 255.0,
+            data.features[start : start + batch_size],
+            data.mask[start : start + batch_size],
+        )
+        for start in range(0, len(data), batch_size)
+    ]
+    return torch.cat(parts)
+
+
+def chosen_regret(scores: torch.Tensor, data: Decisions) -> float:
+    """The mean true regret of the candidate of lowest ``scores`` in each decision."""
+    best = scores.masked_fill(~data.mask, float("inf")).argmin(dim=1)
+    return float(data.regret[torch.arange(len(data)), best].mean())
