@@ -26,10 +26,9 @@ from frontier_marl.policies.base import Info, Policy
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
 from frontier_marl.policies.linear_scorer import explorer_slots, feature_names
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
+from frontier_marl.policies.models import MAP_SCORER_FILE, MAP_SCORER_FORMAT
 from frontier_marl.policies.networks.map_scorer import MapScorer
 
-FORMAT = "map-scorer"
-MODEL_FILE = "model.pt"
 METADATA_FILE = "model.json"
 MAP_EXPLORER_SETTINGS: dict[str, Any] = dict(FRONTIER_RULE_SETTINGS)
 
@@ -42,21 +41,10 @@ def new_scorer(n_features: int, width: int = 32) -> MapScorer:
 def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) -> None:
     """``folder/model.pt`` and ``folder/model.json`` (``metadata`` plus the scorer's shape)."""
     folder.mkdir(parents=True, exist_ok=True)
-    torch.save(model.state_dict(), folder / MODEL_FILE)
+    torch.save(model.state_dict(), folder / MAP_SCORER_FILE)
     shape = {"n_features": model.feature_mean.numel(), "width": model.conv[0].out_channels}
-    record = {"format": FORMAT, "scorer": shape, "env_settings": MAP_EXPLORER_SETTINGS}
+    record = {"format": MAP_SCORER_FORMAT, "scorer": shape, "env_settings": MAP_EXPLORER_SETTINGS}
     (folder / METADATA_FILE).write_text(json.dumps({**record, **metadata}, indent=2) + "\n")
-
-
-def is_map_explorer(folder: Path) -> bool:
-    """Whether ``folder`` holds a saved map explorer."""
-    path = Path(folder) / METADATA_FILE
-    if not path.is_file() or not (Path(folder) / MODEL_FILE).is_file():
-        return False
-    try:
-        return json.loads(path.read_text()).get("format") == FORMAT
-    except ValueError:
-        return False
 
 
 def load_scorer(folder: Path) -> tuple[MapScorer, dict[str, Any]]:
@@ -66,7 +54,7 @@ def load_scorer(folder: Path) -> tuple[MapScorer, dict[str, Any]]:
         metadata = json.loads((folder / METADATA_FILE).read_text())
         shape = metadata["scorer"]
         model = new_scorer(int(shape["n_features"]), int(shape["width"]))
-        model.load_state_dict(torch.load(folder / MODEL_FILE, map_location="cpu"))
+        model.load_state_dict(torch.load(folder / MAP_SCORER_FILE, map_location="cpu"))
     except (OSError, ValueError, KeyError, RuntimeError) as error:
         raise ValueError(f"cannot load the map explorer in {folder}: {error}") from error
     model.eval()

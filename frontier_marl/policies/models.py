@@ -12,6 +12,7 @@ trained is in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.m
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -57,9 +58,33 @@ def pretrained_model_dir(name: str) -> Path:
     if name not in PRETRAINED:
         raise ValueError(f"pretrained model must be one of {pretrained_names()}, got {name!r}")
     folder = resources.files("frontier_marl").joinpath("assets", "models", name)
-    if not isinstance(folder, Path) or not (folder / "model.zip").is_file():
+    files = ("model.zip", MAP_SCORER_FILE)
+    if not isinstance(folder, Path) or not any((folder / f).is_file() for f in files):
         raise ValueError(f"pretrained model {name!r} is missing from the installed package")
     return folder
+
+
+#: A map-aware scorer's folder: ``model.pt`` (torch weights) and ``model.json`` with this
+#: ``format`` (:mod:`frontier_marl.policies.map_explorer`).
+MAP_SCORER_FORMAT = "map-scorer"
+MAP_SCORER_FILE = "model.pt"
+
+
+def map_scorer_folder(name: str | Path) -> Path | None:
+    """The folder of a saved map-aware scorer named by ``name`` (a shipped model's name, its
+    folder, or its ``model.pt``), or None if ``name`` is no such model."""
+    folder = pretrained_model_dir(str(name)) if str(name) in PRETRAINED else Path(name)
+    if folder.is_file() and folder.name == MAP_SCORER_FILE:
+        folder = folder.parent
+    metadata = folder / "model.json"
+    if not (folder / MAP_SCORER_FILE).is_file() or not metadata.is_file():
+        return None
+    try:
+        return (
+            folder if json.loads(metadata.read_text()).get("format") == MAP_SCORER_FORMAT else None
+        )
+    except ValueError:
+        return None
 
 
 #: The algorithm recorded in a model's metadata -> the class that loads it (module, name).

@@ -140,8 +140,8 @@ def relative_regret(cost: np.ndarray, decision: np.ndarray, cap: float = 1.0) ->
     ``cap`` (a candidate twice as dear as the best is as bad as any worse one)."""
     best = np.full(int(decision.max()) + 1, np.inf)
     np.minimum.at(best, decision, cost)
-    cheapest = np.maximum(best[decision], 1.0)
-    return np.minimum(cost / cheapest - 1.0, cap)
+    cheapest = np.maximum(best[decision], 1.0)  # a cost of 0 (nothing left) counts as 1
+    return np.minimum(np.maximum(cost, 1.0) / cheapest - 1.0, cap)
 
 
 def first_choice_of(scores: Callable[[dict[str, np.ndarray], Candidates], np.ndarray]) -> Any:

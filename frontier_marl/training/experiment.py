@@ -43,11 +43,18 @@ from frontier_marl.evaluation.benchmark.families import family, variant_configs
 from frontier_marl.training.algorithms import SB3_ALGORITHMS
 from frontier_marl.training.dqn import DQN, THESIS_DQN
 from frontier_marl.training.ppo import PPO, with_prior_vector
-from frontier_marl.training.settings import CEM_KEYS, TRAIN_KEYS, CEMSettings, TrainSettings
+from frontier_marl.training.settings import (
+    CEM_KEYS,
+    REGRESSION_KEYS,
+    TRAIN_KEYS,
+    CEMSettings,
+    RegressionSettings,
+    TrainSettings,
+)
 
 __all__ = ["Experiment", "TrainSettings", "experiment_from_dict", "load_experiment"]
 
-SECTIONS = ("env", "dqn", "ppo", "train", "cem")
+SECTIONS = ("env", "dqn", "ppo", "train", "cem", "regression")
 
 
 @dataclass(frozen=True)
@@ -60,6 +67,7 @@ class Experiment:
     dqn: dict[str, Any] = field(default_factory=lambda: dict(THESIS_DQN))
     train: TrainSettings = field(default_factory=TrainSettings)
     cem: dict[str, Any] = field(default_factory=dict)
+    regression: dict[str, Any] = field(default_factory=dict)
     ppo: dict[str, Any] = field(default_factory=dict)
     source: str | None = None
 
@@ -102,6 +110,7 @@ class Experiment:
                 "agents": list(self.train.agents),
             },
             **({"cem": dict(self.cem)} if self.cem else {}),
+            **({"regression": dict(self.regression)} if self.regression else {}),
         }
 
     def _uses_ppo(self) -> bool:
@@ -126,7 +135,7 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
     if unknown:
         raise ValueError(
             f"unknown top-level key(s) {sorted(unknown)}{where}; "
-            "allowed: name, description, [env], [dqn], [ppo], [train], [cem]"
+            "allowed: name, description, [env], [dqn], [ppo], [train], [cem], [regression]"
         )
     name = data.get("name")
     if not isinstance(name, str) or not name:
@@ -175,6 +184,14 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
             f"unknown [cem] key(s) {sorted(bad_cem)}{where}; allowed: {sorted(CEM_KEYS)}"
         )
     CEMSettings(**cem)  # raises naming a bad value
+    regression = dict(data.get("regression", {}))
+    bad_regression = set(regression) - REGRESSION_KEYS
+    if bad_regression:
+        raise ValueError(
+            f"unknown [regression] key(s) {sorted(bad_regression)}{where}; "
+            f"allowed: {sorted(REGRESSION_KEYS)}"
+        )
+    RegressionSettings(**regression)
     if isinstance(dqn.get("train_freq"), list):
         dqn["train_freq"] = tuple(dqn["train_freq"])  # SB3 wants (n, "step"|"episode")
     experiment = Experiment(
@@ -184,6 +201,7 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         dqn=dqn,
         train=settings,
         cem=cem,
+        regression=regression,
         ppo=ppo,
         source=source,
     )
@@ -225,7 +243,8 @@ def parse_override(text: str) -> tuple[str, str, Any]:
         section, name = key.split(".", 1)
         if section not in SECTIONS:
             raise ValueError(
-                f"override section must be env, dqn, ppo, train or cem, got {section!r} in {text!r}"
+                f"override section must be one of {', '.join(SECTIONS)}, got {section!r} in "
+                f"{text!r}"
             )
         return section, name, value
     owners = [
@@ -235,13 +254,14 @@ def parse_override(text: str) -> tuple[str, str, Any]:
             ("dqn", dqn_keys()),
             ("ppo", PPO.keyword_names() - dqn_keys()),
             ("cem", CEM_KEYS),
+            ("regression", REGRESSION_KEYS),
             ("env", set(config_keys())),
         )
         if key in keys
     ]
     if not owners:
         raise ValueError(
-            f"unknown override key {key!r}: not an env, dqn, ppo, train or cem key "
+            f"unknown override key {key!r}: not a key of {', '.join(SECTIONS)} "
             "(use section.key=value to be explicit)"
         )
     if len(owners) > 1:

@@ -103,7 +103,7 @@ def fit(
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
-            total, batches = total + float(loss), batches + 1
+            total, batches = total + loss.item(), batches + 1
         losses.append(total / max(batches, 1))
         if callable(on_epoch):
             on_epoch(epoch, losses[-1])

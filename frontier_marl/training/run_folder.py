@@ -29,6 +29,7 @@ LOCK_FILE = ".lock"
 #: What a run writes into its folder (train.py's docstring lists each).
 RUN_OUTPUTS = (
     "model.zip",
+    "model.pt",
     "model.json",
     "evaluation.json",
     "actions.png",
@@ -42,6 +43,7 @@ RUN_OUTPUTS = (
     "tb",
     "checkpoints",
     "best",
+    "labels",
 )
 
 

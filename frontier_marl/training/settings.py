@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
 POLICIES = ("auto", "slot-scorer")
-ALGORITHMS = ("dqn", "ppo", "maskable-ppo", "cem")
+ALGORITHMS = ("dqn", "ppo", "maskable-ppo", "cem", "cost-regression")
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,10 @@ class TrainSettings:
             applied to the policy; needs the batched vector env) or ``cem``: the
             cross-entropy method on a linear slot scorer with ``[cem]``
             (:mod:`frontier_marl.training.cem`; one robot, ``families`` and the explorer
-            features needed; ``total_timesteps``, checkpoints and ``[dqn]`` unused).
+            features needed; ``total_timesteps``, checkpoints and ``[dqn]`` unused), or
+            ``cost-regression``: the map-aware scorer fitted to true-map costs-to-go with
+            ``[regression]`` (:mod:`frontier_marl.training.cost_regression`; one robot and
+            ``families``).
     """
 
     total_timesteps: int = 1_000_000
@@ -112,8 +115,12 @@ class TrainSettings:
             raise ValueError(
                 f"train.algorithm must be one of {list(ALGORITHMS)}, got {self.algorithm!r}"
             )
-        if self.algorithm == "cem" and (not self.families or self.agents != (1,)):
-            raise ValueError("train.algorithm = 'cem' needs train.families and one robot")
+        if self.algorithm in ("cem", "cost-regression") and (
+            not self.families or self.agents != (1,)
+        ):
+            raise ValueError(
+                f"train.algorithm = {self.algorithm!r} needs train.families and one robot"
+            )
         if self.algorithm == "maskable-ppo" and self.vec_env != "batched":
             raise ValueError("train.algorithm = 'maskable-ppo' needs train.vec_env = 'batched'")
         if self.policy not in POLICIES:
@@ -207,3 +214,47 @@ class CEMSettings:
 
 
 CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
+
+
+@dataclass(frozen=True)
+class RegressionSettings:
+    """The ``[regression]`` section: DAgger rounds of true-map labels and fits of the map
+    scorer (:mod:`frontier_marl.training.cost_regression`). The names differ from every other
+    section's, so a bare ``key=value`` override finds its section.
+
+    Attributes:
+        rounds: label-and-fit rounds; round 0 follows frontier-rule, later ones the scorer
+            (each decision the rule's with probability ``rule_share``).
+        label_episodes: training episodes per family per round (fresh seeds every round).
+        label_workers: processes that label episodes side by side.
+        fit_epochs: passes over all labels so far, per round (the scorer starts afresh).
+        fit_batch: decisions per gradient step.
+        fit_rate: Adam's step size.
+        scorer_width: the scorer's channels (its embedding is twice this).
+        rule_share: the rule's share of the decisions in rounds after the first.
+    """
+
+    rounds: int = 3
+    label_episodes: int = 40
+    label_workers: int = 2
+    fit_epochs: int = 10
+    fit_batch: int = 64
+    fit_rate: float = 1e-3
+    scorer_width: int = 32
+    rule_share: float = 0.5
+
+    def __post_init__(self) -> None:
+        integers = ("rounds", "label_episodes", "label_workers", "fit_epochs", "fit_batch")
+        for name in (*integers, "scorer_width"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"regression.{name} must be an integer >= 1, got {value!r}")
+        rate = self.fit_rate
+        if isinstance(rate, bool) or not isinstance(rate, int | float) or not rate > 0:
+            raise ValueError(f"regression.fit_rate must be a number > 0, got {rate!r}")
+        share = self.rule_share
+        if isinstance(share, bool) or not isinstance(share, int | float) or not 0 <= share <= 1:
+            raise ValueError(f"regression.rule_share must be a number in [0, 1], got {share!r}")
+
+
+REGRESSION_KEYS = {f.name for f in dataclasses.fields(RegressionSettings)}

@@ -33,6 +33,7 @@ from frontier_marl.policies.model_files import (
 )
 from frontier_marl.training.algorithms import sb3_algorithm
 from frontier_marl.training.cem import train_cem
+from frontier_marl.training.cost_regression import train_cost_regression
 from frontier_marl.training.experiment import Experiment, experiment_from_dict
 from frontier_marl.training.results import TrainResult
 from frontier_marl.training.run_folder import own_run_folder
@@ -96,12 +97,16 @@ def train(
     settings = experiment.train
     run_dir = Path(run_dir)
     checkpoint = find_checkpoint(resume) if isinstance(resume, str | Path) else resume
-    if settings.algorithm == "cem" and checkpoint is not None:
-        raise ValueError("a train.algorithm = 'cem' run cannot be resumed: start it again")
+    if settings.algorithm in ("cem", "cost-regression") and checkpoint is not None:
+        raise ValueError(
+            f"a train.algorithm = {settings.algorithm!r} run cannot be resumed: start it again"
+        )
     with own_run_folder(run_dir, fresh=checkpoint is None, overwrite=overwrite):
         torch.set_num_threads(settings.torch_threads)
         if settings.algorithm == "cem":
             return train_cem(experiment, run_dir, progress_bar)
+        if settings.algorithm == "cost-regression":
+            return train_cost_regression(experiment, run_dir, progress_bar)
         algorithm = sb3_algorithm(settings.algorithm)
         return train_sb3(
             algorithm, experiment, run_dir, checkpoint, progress_bar, verbose, callbacks

@@ -26,6 +26,7 @@ from frontier_marl.cli.arguments import add_set_argument, non_negative_int, posi
 from frontier_marl.evaluation.model_evaluation import format_comparison
 from frontier_marl.policies.model_files import find_checkpoint
 from frontier_marl.training.experiment import load_experiment, parse_override
+from frontier_marl.training.settings import CEMSettings, RegressionSettings
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -147,17 +148,24 @@ def run(args: argparse.Namespace) -> int:
     budget = (
         f"{settings.total_timesteps} steps, seed {settings.seed}, {worlds} ({settings.vec_env})"
     )
+    if settings.algorithm == "cost-regression":
+        reg = RegressionSettings(**experiment.regression)
+        world = f"families {', '.join(settings.families)}, frontier-rule's observation"
+        budget = (
+            f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "
+            f"episodes per family, {reg.fit_epochs} epochs each, seed {settings.seed}"
+        )
     if settings.algorithm == "cem":
-        from frontier_marl.training.settings import CEMSettings
-
         cem = CEMSettings(**experiment.cem)
         budget = (
             f"cross-entropy method: {cem.generations} generations of {cem.population} weight "
             f"vectors, {cem.episodes} training episodes per family each, seed {settings.seed}"
         )
+    if settings.algorithm != "cost-regression":  # that one takes frontier-rule's observation
+        world += f", reward={cfg.reward.kind}, observation={cfg.observation}"
     print(
         f"{experiment.name}: {experiment.description}\n"
-        f"  env: {world}, reward={cfg.reward.kind}, observation={cfg.observation}\n"
+        f"  env: {world}\n"
         f"  {budget}{start}\n"
         f"  run folder: {run_dir}"
     )

@@ -48,7 +48,12 @@ from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
 from frontier_marl.policies.base import ModelPolicy, Policy, slot_table
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.policies.metadata import ModelEnvMismatchError
-from frontier_marl.policies.models import PRETRAINED, check_model_env, load_model
+from frontier_marl.policies.models import (
+    PRETRAINED,
+    check_model_env,
+    load_model,
+    map_scorer_folder,
+)
 from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
 from frontier_marl.utils.progress import progress_bar
 
@@ -108,6 +113,21 @@ def model(name: str) -> Contender:
     return Contender(label, False, lambda: ModelPolicy(loaded.model, name=label), config)
 
 
+def map_model(folder: Path, label: str) -> Contender:
+    """A saved map-aware scorer (:mod:`frontier_marl.policies.map_explorer`): it chooses among
+    frontier-rule's slots, in frontier-rule's env on each world. Needs torch."""
+    try:  # torch is the train extra's
+        from frontier_marl.policies.map_explorer import MapExplorer, load_scorer
+    except ModuleNotFoundError as exc:
+        raise ValueError(
+            f"model {label}: a map scorer needs torch ({exc.name} is not installed): "
+            "pip install 'frontier-marl[train]'"
+        ) from None
+    scorer, _ = load_scorer(folder)
+    rule = heuristic("frontier-rule")
+    return Contender(label, False, lambda: MapExplorer(scorer, label), rule.config)
+
+
 def oracle() -> Contender:
     """``lookahead-oracle`` (:mod:`frontier_marl.policies.lookahead`): it reads the true map,
     so it is reported beside the others but never counts as the best heuristic."""
@@ -123,6 +143,8 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
             out.append(heuristic(name, commit))
         elif name == ORACLE:
             out.append(oracle())
+        elif (folder := map_scorer_folder(name)) is not None:
+            out.append(map_model(folder, Path(name).name if Path(name).exists() else name))
         elif name in PRETRAINED or Path(name).exists():
             out.append(model(name))
         else:

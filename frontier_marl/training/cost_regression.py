@@ -1,0 +1,192 @@
+"""``train.algorithm = "cost-regression"``: the map-aware explorer, fitted to true-map costs.
+
+Each round (``[regression]``, :class:`~frontier_marl.training.settings.RegressionSettings`):
+
+1. **label**: ``label_episodes`` fresh training episodes of every family (seeds from the
+   family's training range) are played in the scorer's env (frontier-rule's observation on the
+   family's world); round 0 follows frontier-rule, later rounds the scorer with the rule taking
+   a ``rule_share`` of the decisions (DAgger). Every real decision is labelled with each
+   candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.cost_to_go`), in
+   ``label_workers`` processes; ``RUN/labels/round<r>.npz``;
+2. **fit**: a new scorer on every label so far (:mod:`~frontier_marl.training.regression`);
+3. **validate**: the scorer and frontier-rule on the first ``train.validation_episodes``
+   validation episodes of every family; the score is minus the mean per-episode relative T99
+   difference to the rule (``RUN/validation.jsonl``); the best round's scorer is kept in
+   ``RUN/best/``, the last in ``RUN/``.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing as mp
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from frontier_marl.config import EnvConfig, make_config
+from frontier_marl.evaluation.benchmark.families import family, variant_configs, world_settings
+from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_family
+from frontier_marl.evaluation.records import level_key
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.policies.map_explorer import (
+    MAP_EXPLORER_SETTINGS,
+    MapExplorer,
+    new_scorer,
+    save_map_explorer,
+)
+from frontier_marl.training.cost_to_go import Candidates, Samples, label_episode
+from frontier_marl.training.experiment import Experiment
+from frontier_marl.training.family_validation import FAILURE
+from frontier_marl.training.regression import fit, group
+from frontier_marl.training.results import TrainResult
+from frontier_marl.training.settings import RegressionSettings
+from frontier_marl.utils.progress import progress_bar as make_bar
+
+LOG_FILE = "validation.jsonl"
+
+
+def scorer_config(world: EnvConfig) -> EnvConfig:
+    """The scorer's env on a family's world: frontier-rule's observation settings."""
+    return make_config(None, **{**world_settings(world), **MAP_EXPLORER_SETTINGS})
+
+
+def train_cost_regression(
+    experiment: Experiment, run_dir: Path, progress_bar: bool = True
+) -> TrainResult:
+    """Run the rounds of the module docstring for ``experiment`` into ``run_dir``."""
+    settings = experiment.train
+    reg = RegressionSettings(**experiment.regression)
+    torch.manual_seed(settings.seed)
+    started, cpu_started = time.perf_counter(), time.process_time()
+    rng = np.random.default_rng(settings.seed)
+    names = list(settings.families)
+    count = reg.rounds * reg.label_episodes
+    seeds = {name: rng.permutation(np.asarray(family(name).train))[:count] for name in names}
+    validation = Validation(names, settings.validation_episodes)
+    labels, model, best = [], None, -np.inf
+    (run_dir / "labels").mkdir(parents=True, exist_ok=True)
+    log = run_dir / LOG_FILE
+    log.write_text("")
+    bar = make_bar(reg.rounds, disable=not progress_bar, desc="rounds", unit="round")
+    for round_ in range(reg.rounds):
+        chunk = slice(round_ * reg.label_episodes, (round_ + 1) * reg.label_episodes)
+        jobs = [(name, int(seed)) for name in names for seed in seeds[name][chunk]]
+        state = None if model is None else model.state_dict()
+        samples = label_round(jobs, state, reg, settings.seed + round_)
+        samples.save(run_dir / "labels" / f"round{round_}.npz")
+        labels.append(samples)
+        model = fitted(Samples.join(labels), reg, settings.seed + round_)
+        record = {"round": round_, "labels": len(Samples.join(labels)), **validation(model)}
+        record["wall_s"] = time.perf_counter() - started
+        with log.open("a") as handle:
+            handle.write(json.dumps(record) + "\n")
+        meta = {"trained_by": "cost-regression", "experiment": experiment.to_dict(), **record}
+        if record["score"] > best:
+            best = record["score"]
+            save_map_explorer(model, run_dir / "best", meta)
+        bar.update(1)
+        bar.set_postfix(vs_rule=f"{-record['score']:+.1%}")
+    bar.close()
+    save_map_explorer(model, run_dir, meta)
+    wall = time.perf_counter() - started
+    return TrainResult(
+        run_dir=run_dir,
+        model_path=run_dir / "model.pt",
+        num_timesteps=len(Samples.join(labels)),
+        steps_this_session=len(Samples.join(labels)),
+        wall_time_s=wall,
+        cpu_time_s=time.process_time() - cpu_started,
+        interrupted=False,
+        files={"model": run_dir / "model.pt", "best": run_dir / "best", "log": log},
+    )
+
+
+def label_round(
+    jobs: list[tuple[str, int]], state: dict[str, Any] | None, reg: RegressionSettings, seed: int
+) -> Samples:
+    """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes."""
+    tasks = [(name, ep, state, reg.scorer_width, reg.rule_share, seed) for name, ep in jobs]
+    if reg.label_workers == 1:
+        return Samples.join([_label(task) for task in tasks])
+    context = mp.get_context("spawn")  # torch in the workers: no fork of a threaded parent
+    with ProcessPoolExecutor(reg.label_workers, mp_context=context) as pool:
+        return Samples.join(list(pool.map(_label, tasks)))
+
+
+def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Samples:
+    name, episode, state, width, rule_share, seed = task
+    torch.set_num_threads(1)
+    (world,) = variant_configs(family(name), None, 1)
+    cfg = scorer_config(world)
+    rule = weight_vector(FRONTIER_RULE_WEIGHTS, feature_names(cfg), "frontier-rule")
+    rule = rule.astype(np.float32)
+    model = None
+    if state is not None:
+        model = new_scorer(len(rule), width)
+        model.load_state_dict(state)
+        model.eval()
+    choices = np.random.default_rng([seed, episode])
+
+    def behaviour(obs: dict[str, np.ndarray], candidates: Candidates) -> int:
+        if model is None or choices.random() < rule_share:
+            return int(candidates.slots[int(np.argmax(candidates.features @ rule))])
+        crops = torch.as_tensor(candidates.crops)[None]
+        features = torch.as_tensor(candidates.features)[None]
+        with torch.no_grad():
+            regret = model(crops, features, torch.ones((1, len(candidates.slots)), dtype=bool))
+        return int(candidates.slots[int(torch.argmin(regret[0]))])
+
+    return label_episode(cfg, episode, behaviour, family=name)
+
+
+def fitted(samples: Samples, reg: RegressionSettings, seed: int) -> Any:
+    """A new scorer fitted to ``samples``."""
+    decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]))
+    model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
+    valid = decisions.features[decisions.mask]
+    model.feature_mean.copy_(valid.mean(0))
+    model.feature_std.copy_(valid.std(0).clamp(min=1e-3))
+    fit(model, decisions, reg.fit_epochs, reg.fit_batch, reg.fit_rate, seed)
+    model.eval()
+    return model
+
+
+class Validation:
+    """``validation(model)``: the scorer against frontier-rule on validation episodes."""
+
+    def __init__(self, names: list[str], episodes: int) -> None:
+        self.families = [family(name) for name in names]
+        self.episodes = episodes
+        self.worlds = [variant_configs(fam, None, 1) for fam in self.families]
+        rule = heuristic("frontier-rule")
+        pairs = zip(self.families, self.worlds, strict=True)
+        self.rule = [self._t99(fam, rule, worlds) for fam, worlds in pairs]
+
+    def _t99(self, fam: Any, contender: Contender, worlds: list[EnvConfig]) -> list[float | None]:
+        result = run_family(fam, contender, worlds, self.episodes, split="validation")
+        return [e.cells_to_coverage.get(level_key(0.99)) for e in result.episodes]
+
+    def __call__(self, model: Any) -> dict[str, Any]:
+        learner = Contender("explorer", False, lambda: MapExplorer(model), scorer_config)
+        by_family, differences = {}, []
+        for fam, worlds, rule in zip(self.families, self.worlds, self.rule, strict=True):
+            t99 = self._t99(fam, learner, worlds)
+            diffs = [
+                FAILURE if a is None or b is None else a / b - 1.0
+                for a, b in zip(t99, rule, strict=True)
+            ]
+            by_family[fam.name] = float(np.mean(diffs))
+            differences += diffs
+        mean = float(np.mean(differences))
+        return {
+            "score": -mean,
+            "vs_frontier_rule": mean,
+            "by_family": by_family,
+            "episodes": self.episodes,
+            "split": "validation",
+        }

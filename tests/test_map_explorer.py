@@ -1,0 +1,177 @@
+"""The map-aware explorer's parts: crops, cost-to-go labels, the scorer, its fit, the command."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from frontier_marl.cli.main import main  # noqa: E402
+from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN  # noqa: E402
+from frontier_marl.evaluation.benchmark import families as map_families  # noqa: E402
+from frontier_marl.policies import map_crops  # noqa: E402
+from frontier_marl.policies.map_explorer import MapExplorer, load_scorer, new_scorer  # noqa: E402
+from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
+from frontier_marl.training.cost_regression import scorer_config  # noqa: E402
+from frontier_marl.training.cost_to_go import (  # noqa: E402
+    Samples,
+    first_choice_of,
+    label_episode,
+    relative_regret,
+)
+from frontier_marl.training.experiment import load_experiment  # noqa: E402
+from frontier_marl.training.regression import group, symmetry  # noqa: E402
+
+
+def window_mean(plane: np.ndarray, outside: float, target, scale: int, i: int, j: int) -> float:
+    """One crop cell by brute force: the mean over its scale x scale map cells."""
+    height, width = plane.shape
+    half = map_crops.SIDE // 2
+    top = target[0] + (i - half) * scale - scale // 2
+    left = target[1] + (j - half) * scale - scale // 2
+    cells = [
+        plane[r, c] if 0 <= r < height and 0 <= c < width else outside
+        for r in range(top, top + scale)
+        for c in range(left, left + scale)
+    ]
+    return float(np.mean(cells))
+
+
+def test_crops_are_window_means_of_the_belief_on_a_non_square_map() -> None:
+    rng = np.random.default_rng(0)
+    belief = rng.choice([FREE, OCCUPIED, UNKNOWN], size=(9, 14)).astype(np.int8)
+    belief[4, 6] = FREE
+    frontier = rng.random((9, 14)) < 0.2
+    planes = map_crops.map_planes(belief, frontier, (4, 6))
+    targets = np.array([[0, 0], [8, 13], [5, 7]])
+    clusters = [np.array([[0, 0], [0, 1]]), np.array([[8, 13]]), np.array([[5, 7], [6, 7]])]
+    crops = map_crops.candidate_crops(planes, targets, clusters)
+    assert crops.shape == (3, *map_crops.crop_shape())
+    for m, target in enumerate(targets):
+        own = np.zeros(belief.shape)
+        own[tuple(clusters[m].T)] = 1.0
+        channels = [(planes[0], 0.0), (planes[1], 1.0), (planes[2], 0.0), (own, 0.0)]
+        channels.append((planes[3], 1.0))
+        for k, scale in enumerate(map_crops.SCALES):
+            cell = crops[m].reshape(len(map_crops.SCALES), -1, map_crops.SIDE, map_crops.SIDE)[k]
+            for i, j in ((0, 0), (5, 5), (3, 9), (10, 2)):
+                expected = [window_mean(p, out, target, scale, i, j) for p, out in channels]
+                np.testing.assert_allclose(cell[:, i, j], expected, atol=1e-6)
+
+
+def test_relative_regret_is_the_cost_over_the_cheapest_of_its_decision() -> None:
+    regret = relative_regret(np.array([10.0, 15.0, 40.0, 0.0, 3.0]), np.array([0, 0, 0, 1, 1]))
+    np.testing.assert_allclose(regret, [0.0, 0.5, 1.0, 0.0, 1.0])  # capped at 1; 0 cells: 1
+
+
+def test_a_quarter_turn_turns_the_crops_and_the_offsets_alike() -> None:
+    half = map_crops.SIDE // 2
+    for k in range(8):
+        crops = torch.zeros(1, 1, 1, map_crops.SIDE, map_crops.SIDE)
+        crops[0, 0, 0, half - 2, half + 3] = 1.0  # the robot: target minus (2, -3)
+        features = torch.zeros(1, 1, 14)
+        features[..., 2], features[..., 3] = 2.0, -3.0
+        turned, offsets = symmetry(crops, features, k)
+        row, col = (turned[0, 0, 0] == 1).nonzero()[0].tolist()
+        assert (half - row, half - col) == (offsets[0, 0, 2].item(), offsets[0, 0, 3].item())
+
+
+def test_the_scorer_is_permutation_equivariant_and_masks_padding() -> None:
+    torch.manual_seed(0)
+    model = new_scorer(14, width=8)
+    crops = torch.rand(1, 5, *map_crops.crop_shape())
+    features = torch.rand(1, 5, 14)
+    mask = torch.tensor([[True, True, True, False, False]])
+    scores = model(crops, features, mask)
+    assert torch.isinf(scores[0, 3:]).all() and torch.isfinite(scores[0, :3]).all()
+    order = torch.tensor([2, 0, 1, 3, 4])
+    shuffled = model(crops[:, order], features[:, order], mask[:, order])
+    torch.testing.assert_close(shuffled[0, :3], scores[0, order[:3]])
+
+
+@pytest.fixture(scope="module")
+def labelled() -> Samples:
+    fam = map_families.family("random-20")
+    (world,) = map_families.variant_configs(fam, None, 1)
+    nearest = first_choice_of(lambda obs, candidates: candidates.features[:, 0])
+    return label_episode(scorer_config(world), fam.train[0], nearest, family="random-20")
+
+
+def test_labels_give_every_candidate_of_a_decision_its_cost_to_go(labelled: Samples) -> None:
+    decisions = int(labelled.decision.max()) + 1
+    assert decisions > 10 and len(labelled) > 2 * decisions  # real choices, several each
+    assert labelled.crops.dtype == np.uint8 and labelled.features.shape[1] == 14
+    assert (labelled.cost > 0).all() and set(labelled.family) == {"random-20"}
+    grouped = group(labelled, 12)
+    assert len(grouped) == decisions
+    assert (grouped.regret[grouped.mask] >= 0).all()
+    assert (grouped.regret.masked_fill(~grouped.mask, 9).min(dim=1).values == 0).all()
+
+
+def test_samples_survive_a_round_trip_and_a_join(labelled: Samples, tmp_path: Path) -> None:
+    labelled.save(tmp_path / "labels.npz")
+    again = Samples.load(tmp_path / "labels.npz")
+    assert np.array_equal(again.crops, labelled.crops) and np.array_equal(again.cost, labelled.cost)
+    joined = Samples.join([labelled, again])
+    assert len(joined) == 2 * len(labelled)
+    assert joined.decision.max() + 1 == 2 * (labelled.decision.max() + 1)
+
+
+@pytest.mark.slow
+def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    tiny = {
+        "train.families": '["random-20"]',
+        "train.validation_episodes": 1,
+        "regression.rounds": 2,
+        "regression.label_episodes": 1,
+        "regression.label_workers": 1,
+        "regression.fit_epochs": 1,
+    }
+    sets = [arg for key, value in tiny.items() for arg in ("--set", f"{key}={value}")]
+    assert main(["train", "explorer-map", "--out", str(out), "--no-progress", *sets]) == 0
+    records = [json.loads(line) for line in (out / "validation.jsonl").read_text().splitlines()]
+    assert [r["round"] for r in records] == [0, 1] and records[1]["labels"] > records[0]["labels"]
+    assert map_scorer_folder(out / "best") == out / "best"
+    model, meta = load_scorer(out / "best")
+    assert meta["format"] == "map-scorer" and meta["env_settings"]["n_slots"] == 12
+    report = tmp_path / "bench.json"
+    argv = ["benchmark", "--families", "rooms-32", "--episodes", "1", "--split", "validation"]
+    assert main([*argv, "--policies", f"frontier-rule,{out / 'best'}", "--json", str(report)]) == 0
+    rows = json.loads(report.read_text())["rows"]
+    assert [r["policy"] for r in rows] == ["frontier-rule", "best"] and rows[1]["success"] == 1
+    assert rows[1]["config"]["n_slots"] == 12  # frontier-rule's slots
+
+
+def test_the_explorer_acts_on_valid_slots_only() -> None:
+    import frontier_marl
+    from frontier_marl.policies.linear_scorer import explorer_slots
+
+    fam = map_families.family("rooms-32")
+    (world,) = map_families.variant_configs(fam, None, 1)
+    env = frontier_marl.parallel_env(config=scorer_config(world))
+    torch.manual_seed(0)
+    explorer = MapExplorer(new_scorer(14, 8))
+    explorer.attach(env)
+    observations, infos = env.reset(seed=fam.validation[0])
+    choices = 0
+    for _ in range(150):
+        _, mask = explorer_slots(observations["robot_0"])
+        action = explorer.act(observations["robot_0"], infos["robot_0"])
+        assert mask[action] == 1
+        choices += int(mask.sum() > 1)
+        observations, _, _, _, infos = env.step({"robot_0": action})
+    assert choices > 5  # it chose among several slots, not only forced steps
+
+
+def test_a_bad_regression_section_is_named() -> None:
+    with pytest.raises(ValueError, match=r"regression.rounds must be an integer >= 1"):
+        load_experiment("explorer-map", ["regression.rounds=0"])
+    with pytest.raises(ValueError, match=r"unknown \[regression\] key"):
+        load_experiment("explorer-map", ["regression.epochs=3"])
+    with pytest.raises(ValueError, match="needs train.families and one robot"):
+        load_experiment("explorer-map", ["train.families=[]"])
