@@ -23,8 +23,8 @@ import numpy as np
 import torch
 
 from frontier_marl.policies.base import Info, Policy
-from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
-from frontier_marl.policies.linear_scorer import explorer_slots, feature_names
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS, FRONTIER_RULE_WEIGHTS
+from frontier_marl.policies.linear_scorer import explorer_slots, feature_names, weight_vector
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
 from frontier_marl.policies.models import MAP_SCORER_FILE, MAP_SCORER_FORMAT
 from frontier_marl.policies.networks.map_scorer import MapScorer
@@ -62,20 +62,25 @@ def load_scorer(folder: Path) -> tuple[MapScorer, dict[str, Any]]:
 
 
 class MapExplorer(Policy):
-    """The valid slot of lowest predicted regret; one robot (a team's robots would need
-    their own slot tables: not built yet)."""
+    """The valid slot of lowest ``predicted regret + rule_weight * rule margin``, where a
+    slot's rule margin is how far frontier-rule's score of it falls below the best slot's
+    (0 for the rule's own choice): ``rule_weight`` 0 is the scorer alone, a large one the
+    rule, between them the scorer overrules the rule only where it predicts a clear gain.
+    One robot (a team's robots would need their own slot tables: not built yet)."""
 
     deterministic = True
 
-    def __init__(self, model: MapScorer, name: str = "explorer") -> None:
+    def __init__(self, model: MapScorer, name: str = "explorer", rule_weight: float = 0.0) -> None:
         self.model = model
         self.name = name
+        self.rule_weight = float(rule_weight)
         self._env: Any = None
+        self._rule: np.ndarray | None = None
 
     @classmethod
     def load(cls, folder: Path, name: str = "explorer") -> MapExplorer:
-        model, _ = load_scorer(folder)
-        return cls(model, name)
+        model, metadata = load_scorer(folder)
+        return cls(model, name, float(metadata.get("rule_weight", 0.0)))
 
     def attach(self, env: Any) -> None:
         expected = self.model.feature_mean.numel()
@@ -85,6 +90,8 @@ class MapExplorer(Policy):
                 f"{len(feature_names(env.config))}: run it with its env settings"
             )
         self._env = env
+        names = feature_names(env.config)
+        self._rule = weight_vector(FRONTIER_RULE_WEIGHTS, names, "frontier-rule")
 
     def act(self, obs: Any, info: Info) -> int:
         if self._env is None:
@@ -97,5 +104,8 @@ class MapExplorer(Policy):
         features = torch.as_tensor(slots[valid], dtype=torch.float32)[None]
         mask = torch.ones((1, len(valid)), dtype=torch.bool)
         with torch.no_grad():
-            regret = self.model(torch.as_tensor(crops)[None], features, mask)[0]
-        return int(valid[int(torch.argmin(regret))])
+            regret = self.model(torch.as_tensor(crops)[None], features, mask)[0].numpy()
+        if self.rule_weight:
+            rule = slots[valid].astype(np.float64) @ self._rule
+            regret = regret + self.rule_weight * (rule.max() - rule)
+        return int(valid[int(np.argmin(regret))])

@@ -81,7 +81,11 @@ def train_cost_regression(
         samples.save(run_dir / "labels" / f"round{round_}.npz")
         labels.append(samples)
         model = fitted(Samples.join(labels), reg, settings.seed + round_)
-        record = {"round": round_, "labels": len(Samples.join(labels)), **validation(model)}
+        tried = {weight: validation(model, weight) for weight in reg.rule_weights}
+        weight = max(tried, key=lambda w: tried[w]["score"])
+        record = {"round": round_, "labels": len(Samples.join(labels)), **tried[weight]}
+        record["rule_weight"] = weight
+        record["by_rule_weight"] = {str(w): t["vs_frontier_rule"] for w, t in tried.items()}
         record["wall_s"] = time.perf_counter() - started
         with log.open("a") as handle:
             handle.write(json.dumps(record) + "\n")
@@ -171,8 +175,11 @@ class Validation:
         result = run_family(fam, contender, worlds, self.episodes, split="validation")
         return [e.cells_to_coverage.get(level_key(0.99)) for e in result.episodes]
 
-    def __call__(self, model: Any) -> dict[str, Any]:
-        learner = Contender("explorer", False, lambda: MapExplorer(model), scorer_config)
+    def __call__(self, model: Any, rule_weight: float = 0.0) -> dict[str, Any]:
+        def make() -> MapExplorer:
+            return MapExplorer(model, "explorer", rule_weight)
+
+        learner = Contender("explorer", False, make, scorer_config)
         by_family, differences = {}, []
         for fam, worlds, rule in zip(self.families, self.worlds, self.rule, strict=True):
             t99 = self._t99(fam, learner, worlds)

@@ -232,6 +232,9 @@ class RegressionSettings:
         fit_rate: Adam's step size.
         scorer_width: the scorer's channels (its embedding is twice this).
         rule_share: the rule's share of the decisions in rounds after the first.
+        rule_weights: the weights of frontier-rule's margin tried after each fit
+            (:class:`~frontier_marl.policies.map_explorer.MapExplorer`); the best on the
+            validation episodes is kept with the scorer.
     """
 
     rounds: int = 3
@@ -242,8 +245,16 @@ class RegressionSettings:
     fit_rate: float = 1e-3
     scorer_width: int = 32
     rule_share: float = 0.5
+    rule_weights: tuple[float, ...] = (0.0,)
 
     def __post_init__(self) -> None:
+        weights = self.rule_weights
+        if not isinstance(weights, tuple | list) or not weights or not all(
+            isinstance(w, int | float) and not isinstance(w, bool) and w >= 0 for w in weights
+        ):
+            raise ValueError(
+                f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
+            )
         integers = ("rounds", "label_episodes", "label_workers", "fit_epochs", "fit_batch")
         for name in (*integers, "scorer_width"):
             value = getattr(self, name)
