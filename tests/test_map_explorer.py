@@ -13,6 +13,7 @@ torch = pytest.importorskip("torch")
 from frontier_marl.cli.main import main  # noqa: E402
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN  # noqa: E402
 from frontier_marl.evaluation.benchmark import families as map_families  # noqa: E402
+from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
 from frontier_marl.policies.map_explorer import MapExplorer, load_scorer, new_scorer  # noqa: E402
 from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
@@ -145,6 +146,27 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     rows = json.loads(report.read_text())["rows"]
     assert [r["policy"] for r in rows] == ["frontier-rule", "best"] and rows[1]["success"] == 1
     assert rows[1]["config"]["n_slots"] == 12  # frontier-rule's slots
+    probe_json = tmp_path / "probe.json"
+    probe_args = ["--families", "random-20", "--episodes", "1", "--label-episodes", "1"]
+    assert (
+        probe_main(
+            [
+                str(out / "best"),
+                "--weights",
+                "0,1",
+                *probe_args,
+                "--no-progress",
+                "--json",
+                str(probe_json),
+            ]
+        )
+        == 0
+    )
+    probe = json.loads(probe_json.read_text())
+    choosers = probe["decisions"]["random-20"]["choosers"]
+    assert {"scorer (rule weight 0)", "scorer (rule weight 1)", "frontier-rule"} <= set(choosers)
+    assert all(0 <= c["cheapest"] <= 1 and c["regret"] >= 0 for c in choosers.values())
+    assert [r["policy"] for r in probe["rows"]] == ["frontier-rule", "scorer-w0", "scorer-w1"]
 
 
 def test_the_explorer_acts_on_valid_slots_only() -> None:
