@@ -59,6 +59,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -128,13 +129,40 @@ QUICK_REFINE: dict[str, Any] = {
     "max_cluster_cells": [6, 8],
 }
 
+#: A results row: one evaluated setting with its figures (see ``Evaluator.run``).
+Row = dict[str, Any]
+
 #: The default folder of ``--out``, relative to the working directory (the repository root).
 RESULTS = Path("baselines") / "results"
 
 
-def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
-    """The command line of ``baselines/calibrate.py``, which passes its own ``results/`` folder
-    as ``results_dir`` (where ``--out`` goes by default)."""
+@dataclass
+class _Search:
+    """What stages 1-3 of the search found, passed on to the checks and the results file."""
+
+    stage1: list[Row]
+    stage1_fits: int
+    stage1_cpu: float
+    refined: list[Row]
+    stage2_cpu: float
+    fitting: list[Row]
+    validation: list[Row]
+    choice: Row
+    search_cpu: float
+    n_settings: int
+
+    @property
+    def winner(self) -> Row:
+        """The chosen setting's row on the calibration seeds."""
+        return self.choice["calibration"]
+
+
+def _log(text: str) -> None:
+    print(text, flush=True)
+
+
+def _parse_args(argv: list[str] | None, results_dir: Path) -> argparse.Namespace:
+    """The options, with ``--quick`` applied and ``--out`` defaulted under ``results_dir``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0, help="episode i uses reset seed seed+i")
@@ -166,65 +194,74 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
     if args.out is None:
         name = "calibration-quick.json" if args.quick else "calibration.json"
         args.out = results_dir / name
-    coarse = QUICK_COARSE if args.quick else COARSE
-    refine = QUICK_REFINE if args.quick else REFINE
+    return args
 
-    def log(text: str) -> None:
-        print(text, flush=True)
 
-    wall = time.perf_counter()
+def _evaluator(args: argparse.Namespace) -> Evaluator:
+    """The evaluator of the options, after logging the target and running the reference."""
     options = {}
     if args.protocol:
         options = {n: dict(THESIS_PROTOCOL[n]) for n in POLICIES if n in THESIS_PROTOCOL}
     ev = Evaluator(args.episodes, args.seed, args.map_seed, args.reward, options)
-    log(
+    _log(
         f"calibrating against GD {THESIS['greedy-distance']} and GG {THESIS['greedy-gain']}: "
         f"{args.episodes} episodes, seed {args.seed}, static map seed {args.map_seed}, "
         f"{args.reward}"
     )
     reference = ev.run(dict(REFERENCE), stage="reference")
     if options:
-        log(f"heuristic options: {options}")
-    log(f"reference: {summary_line(reference)}")
+        _log(f"heuristic options: {options}")
+    _log(f"reference: {summary_line(reference)}")
+    return ev
 
-    # Stage 1 ------------------------------------------------------------------------------
+
+def _coarse_stage(
+    ev: Evaluator, coarse: dict[str, list[Any]], tolerance: float
+) -> tuple[list[Row], int]:
+    """Stage 1: every coarse grid point, best first, and how many of them fit."""
     grid = list(grid_points(coarse))
-    log(f"\nstage 1: coarse grid, {len(grid)} settings")
+    _log(f"\nstage 1: coarse grid, {len(grid)} settings")
     stage1 = []
     for i, point in enumerate(grid, 1):
         stage1.append(ev.run({**REFERENCE, **point}, stage="coarse"))
         if i % 40 == 0 or i == len(grid):
-            log(f"  {i}/{len(grid)} done, {ev.cpu_seconds:.0f} s CPU so far")
+            _log(f"  {i}/{len(grid)} done, {ev.cpu_seconds:.0f} s CPU so far")
     stage1.sort(key=lambda r: r["score"])
     for row in stage1[:10]:
-        log(f"  {summary_line(row)}  | " + setting_text({k: row["setting"][k] for k in coarse}))
-    stage1_fits = sum(fits(r, args.tolerance) for r in stage1)
-    stage1_cpu = ev.cpu_seconds
-    log(f"  {stage1_fits} of {len(stage1)} coarse settings fit within ±{args.tolerance}")
+        _log(f"  {summary_line(row)}  | " + setting_text({k: row["setting"][k] for k in coarse}))
+    stage1_fits = sum(fits(r, tolerance) for r in stage1)
+    _log(f"  {stage1_fits} of {len(stage1)} coarse settings fit within ±{tolerance}")
+    return stage1, stage1_fits
 
-    # Stage 2 ------------------------------------------------------------------------------
+
+def _refine_stage(
+    ev: Evaluator, stage1: list[Row], refine: dict[str, Any], args: argparse.Namespace
+) -> list[Row]:
+    """Stage 2: coordinate descent from the ``--top`` best distinct coarse settings."""
     starts = distinct(stage1, args.top)
-    log(f"\nstage 2: coordinate descent from the {len(starts)} best distinct coarse settings")
+    _log(f"\nstage 2: coordinate descent from the {len(starts)} best distinct coarse settings")
     refined = []
     for i, row in enumerate(starts, 1):
         best, moves = coordinate_descent(
-            ev, row["setting"], refine, args.passes, args.min_gain, f"start {i}", log
+            ev, row["setting"], refine, args.passes, args.min_gain, f"start {i}", _log
         )
         refined.append({"start": row["setting"], "best": best, "moves": moves})
-        log(f"  start {i} -> {summary_line(best)}\n           {setting_text(best['setting'])}")
-    stage2_cpu = ev.cpu_seconds - stage1_cpu
+        _log(f"  start {i} -> {summary_line(best)}\n           {setting_text(best['setting'])}")
+    return refined
 
-    # Stage 3 ------------------------------------------------------------------------------
-    evaluated = sorted(ev.cache.values(), key=lambda r: r["score"])
-    fitting = [r for r in evaluated if fits(r, args.tolerance)]
-    log(f"\n{len(fitting)} of {len(evaluated)} evaluated settings fit within ±{args.tolerance}")
-    # Candidates: the coarse settings and the stage-2 end points, not the one-parameter probes
-    # that coordinate descent rejected (they lost to the plainer value by less than min-gain).
+
+def _finalists(stage1: list[Row], refined: list[Row], args: argparse.Namespace) -> list[Row]:
+    """The best distinct fitting coarse settings and stage-2 end points, or the best of them if
+    none fits (not the probes coordinate descent rejected: they lost by less than min-gain)."""
     pool = {setting_key(r["setting"]): r for r in stage1 + [r["best"] for r in refined]}
     candidates = sorted(pool.values(), key=lambda r: r["score"])
     finalists = distinct([r for r in candidates if fits(r, args.tolerance)], args.validate)
-    finalists = finalists or candidates[:1]
-    log(
+    return finalists or candidates[:1]
+
+
+def _validate_stage(ev: Evaluator, finalists: list[Row], args: argparse.Namespace) -> list[Row]:
+    """Stage 3: each finalist again on the held-out episode seeds, with its total score."""
+    _log(
         f"stage 3: validation of {len(finalists)} fitting settings on episode seeds "
         f"{args.check_seed}..{args.check_seed + args.episodes - 1}"
     )
@@ -235,47 +272,90 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
         validation.append(
             {"setting": row["setting"], "calibration": row, "held_out": held, "total": total}
         )
-        log(f"  cal. {summary_line(row)}\n  held {summary_line(held)}  -> total {total:.3f}")
-        log(f"       {setting_text(row['setting'])}")
-    choice = min(validation, key=lambda v: v["total"])
-    winner = choice["calibration"]
-    search_cpu = ev.cpu_seconds
-    n_settings = sum(1 for r in ev.cache.values() if r["stage"] != "validation")
-    log(f"\nwinner: {setting_text(winner['setting'])}\n        {summary_line(winner)}")
-    log(f"held out: {summary_line(choice['held_out'])}")
-    log(f"fits within ±{args.tolerance}: {fits(winner, args.tolerance)}")
-    log(
-        f"search: {n_settings} settings + {len(validation)} validation runs, "
-        f"{search_cpu:.0f} s CPU (stage 1 {stage1_cpu:.0f} s, stage 2 {stage2_cpu:.0f} s)"
+        _log(f"  cal. {summary_line(row)}\n  held {summary_line(held)}  -> total {total:.3f}")
+        _log(f"       {setting_text(row['setting'])}")
+    return validation
+
+
+def _search(ev: Evaluator, args: argparse.Namespace) -> _Search:
+    """Stages 1-3: the coarse grid, the refinement and the validation, with the winner."""
+    coarse = QUICK_COARSE if args.quick else COARSE
+    refine = QUICK_REFINE if args.quick else REFINE
+    stage1, stage1_fits = _coarse_stage(ev, coarse, args.tolerance)
+    stage1_cpu = ev.cpu_seconds
+    refined = _refine_stage(ev, stage1, refine, args)
+    stage2_cpu = ev.cpu_seconds - stage1_cpu
+    evaluated = sorted(ev.cache.values(), key=lambda r: r["score"])
+    fitting = [r for r in evaluated if fits(r, args.tolerance)]
+    _log(f"\n{len(fitting)} of {len(evaluated)} evaluated settings fit within ±{args.tolerance}")
+    validation = _validate_stage(ev, _finalists(stage1, refined, args), args)
+    search = _Search(
+        stage1=stage1,
+        stage1_fits=stage1_fits,
+        stage1_cpu=stage1_cpu,
+        refined=refined,
+        stage2_cpu=stage2_cpu,
+        fitting=fitting,
+        validation=validation,
+        choice=min(validation, key=lambda v: v["total"]),
+        search_cpu=ev.cpu_seconds,
+        n_settings=sum(1 for r in ev.cache.values() if r["stage"] != "validation"),
+    )
+    _log_winner(search, args.tolerance)
+    return search
+
+
+def _log_winner(search: _Search, tolerance: float) -> None:
+    winner = search.winner
+    _log(f"\nwinner: {setting_text(winner['setting'])}\n        {summary_line(winner)}")
+    _log(f"held out: {summary_line(search.choice['held_out'])}")
+    _log(f"fits within ±{tolerance}: {fits(winner, tolerance)}")
+    _log(
+        f"search: {search.n_settings} settings + {len(search.validation)} validation runs, "
+        f"{search.search_cpu:.0f} s CPU (stage 1 {search.stage1_cpu:.0f} s, "
+        f"stage 2 {search.stage2_cpu:.0f} s)"
     )
 
-    # Stage 4 ------------------------------------------------------------------------------
-    log("\nstage 4: checks of the winner (not used to choose)")
+
+def _check_winner(ev: Evaluator, winner: Row, quick: bool) -> dict[str, Row]:
+    """Stage 4: the winner under Reward 1, the dynamic map and (full run) other map seeds."""
+    _log("\nstage 4: checks of the winner (not used to choose)")
     checks = {}
-    variants: dict[str, dict[str, Any]] = {
+    variants: dict[str, Row] = {
         "reward1": {"reward": "reward1"},
         "dynamic map": {"map_mode": "dynamic"},
     }
-    if not args.quick:
+    if not quick:
         for map_seed in range(1, 5):
             variants[f"map_seed {map_seed}"] = {"map_seed": map_seed}
     for label, extra in variants.items():
         row = ev.run(winner["setting"], stage="check", **extra)
         checks[label] = row
-        log(f"  {label:12s} {summary_line(row)}")
+        _log(f"  {label:12s} {summary_line(row)}")
+    return checks
 
-    wall_s = time.perf_counter() - wall
-    out = {
+
+def _results(
+    args: argparse.Namespace,
+    ev: Evaluator,
+    search: _Search,
+    checks: dict[str, Row],
+    wall_s: float,
+    argv: list[str] | None,
+) -> dict[str, Any]:
+    """The contents of the results file."""
+    refine = QUICK_REFINE if args.quick else REFINE
+    return {
         "thesis": THESIS,
         "episodes": args.episodes,
         "seed": args.seed,
         "check_seed": args.check_seed,
         "map_seed": args.map_seed,
         "reward": args.reward,
-        **({"policy_options": options} if options else {}),
+        **({"policy_options": ev.options} if ev.options else {}),
         "fixed": FIXED,
         "reference": REFERENCE,
-        "coarse_space": coarse,
+        "coarse_space": QUICK_COARSE if args.quick else COARSE,
         "refine_space": {k: list(v) for k, v in refine.items()},
         "score": {
             "std_weight": STD_WEIGHT,
@@ -284,24 +364,36 @@ def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
             "min_gain": args.min_gain,
             "tolerance": args.tolerance,
         },
-        "winner": winner,
-        "winner_held_out": choice["held_out"],
-        "winner_fits": fits(winner, args.tolerance),
-        "refined": refined,
-        "validation": validation,
+        "winner": search.winner,
+        "winner_held_out": search.choice["held_out"],
+        "winner_fits": fits(search.winner, args.tolerance),
+        "refined": search.refined,
+        "validation": search.validation,
         "checks": checks,
-        "settings_evaluated": n_settings,
-        "coarse_fits": stage1_fits,
-        "fitting_settings": len(fitting),
-        "stage1_cpu_s": round(stage1_cpu, 1),
-        "stage2_cpu_s": round(stage2_cpu, 1),
-        "search_cpu_s": round(search_cpu, 1),
+        "settings_evaluated": search.n_settings,
+        "coarse_fits": search.stage1_fits,
+        "fitting_settings": len(search.fitting),
+        "stage1_cpu_s": round(search.stage1_cpu, 1),
+        "stage2_cpu_s": round(search.stage2_cpu, 1),
+        "search_cpu_s": round(search.search_cpu, 1),
         "total_cpu_s": round(ev.cpu_seconds, 1),
         "wall_s": round(wall_s, 1),
         "command": "python baselines/calibrate.py " + " ".join(argv or sys.argv[1:]),
         "rows": sorted(ev.cache.values(), key=lambda r: (r["stage"], r["score"])),
     }
+
+
+def main(argv: list[str] | None = None, *, results_dir: Path = RESULTS) -> int:
+    """The command line of ``baselines/calibrate.py``, which passes its own ``results/`` folder
+    as ``results_dir`` (where ``--out`` goes by default)."""
+    args = _parse_args(argv, results_dir)
+    wall = time.perf_counter()
+    ev = _evaluator(args)
+    search = _search(ev, args)
+    checks = _check_winner(ev, search.winner, args.quick)
+    wall_s = time.perf_counter() - wall
+    out = _results(args, ev, search, checks, wall_s, argv)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(out, indent=1))
-    log(f"\nwrote {args.out} ({ev.cpu_seconds:.0f} s CPU, {wall_s:.0f} s wall)")
+    _log(f"\nwrote {args.out} ({ev.cpu_seconds:.0f} s CPU, {wall_s:.0f} s wall)")
     return 0
