@@ -244,6 +244,110 @@ def _failed_row(spec: TrialSpec, error: str) -> dict[str, Any]:
     }
 
 
+@dataclass(frozen=True)
+class _CampaignSettings:
+    """The arguments of :func:`run_campaign` that reach the log line and the table."""
+
+    configs: Sequence[str | Path]
+    seeds: Sequence[int]
+    budgets: Sequence[int]
+    out: Path
+    address: str | None
+    cpus_per_trial: float
+    max_concurrent: int | None
+    eval_episodes: int
+    overrides: Sequence[str]
+
+    def __post_init__(self) -> None:
+        if not self.cpus_per_trial > 0:
+            raise ValueError(f"--cpus-per-trial must be > 0, got {self.cpus_per_trial!r}")
+        if self.max_concurrent is not None and self.max_concurrent < 1:
+            raise ValueError(f"--max-concurrent must be >= 1, got {self.max_concurrent!r}")
+
+    def table_extra(self, wall: float) -> dict[str, Any]:
+        """The campaign's settings and wall time, as recorded in ``campaign.json``."""
+        return {
+            "configs": [str(c) for c in self.configs],
+            "seeds": list(self.seeds),
+            "budgets": list(self.budgets),
+            "eval_episodes": self.eval_episodes,
+            "overrides": list(self.overrides),
+            "address": self.address,
+            "cpus_per_trial": self.cpus_per_trial,
+            "max_concurrent": self.max_concurrent,
+            "wall_time_s": round(wall, 2),
+        }
+
+
+def _init_ray(address: str | None, log: Callable[[str], None]) -> bool:
+    """Start or connect to Ray unless it is already initialised; whether it was started."""
+    import ray
+
+    if not ray.is_initialized():
+        try:
+            ray.init(
+                address=address,
+                include_dashboard=False,
+                log_to_driver=False,
+                configure_logging=False,
+            )
+        except ConnectionError as exc:
+            raise ValueError(f"--address {address}: cannot connect to Ray: {exc}") from exc
+        return True
+    if address is not None:
+        log(f"note: Ray is already initialised; ignoring --address {address}")
+    return False
+
+
+def _log_start(
+    settings: _CampaignSettings, trials: Sequence[TrialSpec], log: Callable[[str], None]
+) -> None:
+    """Log the trials, the cluster's CPUs, the per-trial resources and the output folder."""
+    import ray
+
+    resources = ray.cluster_resources()
+    address, max_concurrent = settings.address, settings.max_concurrent
+    log(
+        f"campaign: {len(trials)} trial(s) on Ray ({resources.get('CPU', 0):.0f} CPUs"
+        f"{', ' + address if address else ', local'}), {settings.cpus_per_trial} CPU(s) per trial"
+        f"{f', at most {max_concurrent} at once' if max_concurrent else ''} -> {settings.out}"
+    )
+
+
+def _grid_row(result: Any, trials: Sequence[TrialSpec]) -> dict[str, Any]:
+    """The table row of one Ray Tune result: its report, or a failed row."""
+    spec = trials[int(result.config["trial"])]
+    if result.error is not None:
+        lines = str(result.error).strip().splitlines() or [type(result.error).__name__]
+        return _failed_row(spec, lines[-1].strip())
+    if not result.metrics or "mean_reward" not in result.metrics:
+        return _failed_row(spec, "the trial reported no result")
+    return _row_from_report(dict(result.metrics), spec)
+
+
+def _fit(
+    tune: Any, settings: _CampaignSettings, trials: list[TrialSpec], progress: bool, shutdown: bool
+) -> Any:
+    """Run the trials on Ray Tune; shut Ray down afterwards if ``shutdown`` (Ray started here)."""
+    import ray
+
+    try:
+        names = [spec.name for spec in trials]
+        return fit_trials(
+            tune,
+            _ray_trainable,
+            names,
+            settings.out,
+            settings.cpus_per_trial,
+            settings.max_concurrent,
+            progress,
+            trials=list(trials),
+        )
+    finally:
+        if shutdown:
+            ray.shutdown()
+
+
 def run_campaign(
     configs: Sequence[str | Path],
     seeds: Sequence[int],
@@ -264,84 +368,32 @@ def run_campaign(
     input (before Ray starts).
     """
     tune = require_ray()
-    import ray
-
-    if not cpus_per_trial > 0:
-        raise ValueError(f"--cpus-per-trial must be > 0, got {cpus_per_trial!r}")
-    if max_concurrent is not None and max_concurrent < 1:
-        raise ValueError(f"--max-concurrent must be >= 1, got {max_concurrent!r}")
+    settings = _CampaignSettings(
+        configs,
+        seeds,
+        budgets,
+        Path(out).resolve(),
+        address,
+        cpus_per_trial,
+        max_concurrent,
+        eval_episodes,
+        overrides,
+    )  # checks the Ray options before the configs are read
     trials = build_grid(
         configs, seeds, budgets, out, eval_episodes=eval_episodes, overrides=overrides
     )
-    out = Path(out).resolve()
-    out.mkdir(parents=True, exist_ok=True)
-
-    started_ray = False
-    if not ray.is_initialized():
-        try:
-            ray.init(
-                address=address,
-                include_dashboard=False,
-                log_to_driver=False,
-                configure_logging=False,
-            )
-        except ConnectionError as exc:
-            raise ValueError(f"--address {address}: cannot connect to Ray: {exc}") from exc
-        started_ray = True
-    elif address is not None:
-        log(f"note: Ray is already initialised; ignoring --address {address}")
-    resources = ray.cluster_resources()
-    log(
-        f"campaign: {len(trials)} trial(s) on Ray ({resources.get('CPU', 0):.0f} CPUs"
-        f"{', ' + address if address else ', local'}), {cpus_per_trial} CPU(s) per trial"
-        f"{f', at most {max_concurrent} at once' if max_concurrent else ''} -> {out}"
-    )
-
+    settings.out.mkdir(parents=True, exist_ok=True)
+    started_ray = _init_ray(address, log)
+    _log_start(settings, trials, log)
     started = time.perf_counter()
-    try:
-        names = [spec.name for spec in trials]
-        grid = fit_trials(
-            tune,
-            _ray_trainable,
-            names,
-            out,
-            cpus_per_trial,
-            max_concurrent,
-            progress,
-            trials=list(trials),
-        )
-    finally:
-        if started_ray:
-            ray.shutdown()
-    rows = []
-    for result in grid:
-        index = int(result.config["trial"])
-        spec = trials[index]
-        if result.error is not None:
-            lines = str(result.error).strip().splitlines() or [type(result.error).__name__]
-            rows.append(_failed_row(spec, lines[-1].strip()))
-        elif not result.metrics or "mean_reward" not in result.metrics:
-            rows.append(_failed_row(spec, "the trial reported no result"))
-        else:
-            rows.append(_row_from_report(dict(result.metrics), spec))
-    rows = sort_rows(rows)
+    grid = _fit(tune, settings, trials, progress, started_ray)
+    rows = sort_rows([_grid_row(result, trials) for result in grid])
     wall = time.perf_counter() - started
-    columns = (*SUMMARY_COLUMNS, *TRIAL_COLUMNS)
     files = write_table(
         rows,
-        out / "campaign",
+        settings.out / "campaign",
         title=f"Campaign: {len(trials)} trial(s), {eval_episodes} evaluation episodes each",
-        columns=columns,
-        extra={
-            "configs": [str(c) for c in configs],
-            "seeds": list(seeds),
-            "budgets": list(budgets),
-            "eval_episodes": eval_episodes,
-            "overrides": list(overrides),
-            "address": address,
-            "cpus_per_trial": cpus_per_trial,
-            "max_concurrent": max_concurrent,
-            "wall_time_s": round(wall, 2),
-        },
+        columns=(*SUMMARY_COLUMNS, *TRIAL_COLUMNS),
+        extra=settings.table_extra(wall),
     )
     return CampaignResult(rows=rows, files=files, wall_time_s=wall)
