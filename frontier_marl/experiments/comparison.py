@@ -108,9 +108,8 @@ def _cells(row: Mapping[str, Any]) -> dict[str, str]:
     }
 
 
-def format_comparison_markdown(table: Mapping[str, Any]) -> str:
-    """The comparison as Markdown: setting, table, seed spread, acceptance checks."""
-    setting, training = table["setting"], table["training"]
+def _training_text(training: Mapping[str, Any]) -> tuple[str, str, str]:
+    """The runs, their wall times and what the DQN rows report, as phrases."""
     seeds = training["seeds"]
     walls = ", ".join(f"{run['wall_time_s']:.0f}" for run in training["runs"])
     if len(seeds) == 1:
@@ -124,23 +123,14 @@ def format_comparison_markdown(table: Mapping[str, Any]) -> str:
         )
         walls = f"training wall time per run {walls} s"
         reports = f"The DQN rows are each run's {training['reported_policy']}"
-    lines = [
-        f"# {table['title']}",
-        "",
-        f"{setting['preset']} ({setting['height']}x{setting['width']}, "
-        f"r={setting['perception_range']}), {setting['map_mode']} map "
-        f"(map_seed {setting['map_seed']}), {setting['episodes']} deterministic episodes "
-        f"(reset seeds {setting['seeds'][0]}..{setting['seeds'][1]}), the same episodes for "
-        "every policy.",
-        f"DQN: {training['config']} ({training['description']}), {runs} (thesis: "
-        f"{training['thesis_steps']}), {walls}. {reports}.",
-        "",
-        "| " + " | ".join(header for _key, header in COLUMNS) + " |",
-        "|" + "---|" * len(COLUMNS),
-    ]
-    for row in table["rows"]:
-        cells = _cells(row)
-        lines.append("| " + " | ".join(cells[key] for key, _header in COLUMNS) + " |")
+    return runs, walls, reports
+
+
+def _after_table_lines(table: Mapping[str, Any]) -> list[str]:
+    """The lines below the table: the seed spread (several seeds) and the checks."""
+    training = table["training"]
+    seeds = training["seeds"]
+    lines: list[str] = []
     spread = table["seed_spread"]
     if len(seeds) > 1:
         means = ", ".join(f"{m:.2f}" for m in spread["means"])
@@ -163,6 +153,31 @@ def format_comparison_markdown(table: Mapping[str, Any]) -> str:
             f"- note: trained for {training['steps']} steps, fewer than the thesis's "
             f"{training['thesis_steps']}; the DQN row is not expected to match."
         )
+    return lines
+
+
+def format_comparison_markdown(table: Mapping[str, Any]) -> str:
+    """The comparison as Markdown: setting, table, seed spread, acceptance checks."""
+    setting, training = table["setting"], table["training"]
+    runs, walls, reports = _training_text(training)
+    lines = [
+        f"# {table['title']}",
+        "",
+        f"{setting['preset']} ({setting['height']}x{setting['width']}, "
+        f"r={setting['perception_range']}), {setting['map_mode']} map "
+        f"(map_seed {setting['map_seed']}), {setting['episodes']} deterministic episodes "
+        f"(reset seeds {setting['seeds'][0]}..{setting['seeds'][1]}), the same episodes for "
+        "every policy.",
+        f"DQN: {training['config']} ({training['description']}), {runs} (thesis: "
+        f"{training['thesis_steps']}), {walls}. {reports}.",
+        "",
+        "| " + " | ".join(header for _key, header in COLUMNS) + " |",
+        "|" + "---|" * len(COLUMNS),
+    ]
+    for row in table["rows"]:
+        cells = _cells(row)
+        lines.append("| " + " | ".join(cells[key] for key, _header in COLUMNS) + " |")
+    lines += _after_table_lines(table)
     return "\n".join(lines) + "\n"
 
 
@@ -215,23 +230,14 @@ def seed_spread(seeds: Sequence[int], rows: Sequence[Mapping[str, Any]]) -> dict
     }
 
 
-def comparison_table(
-    experiment: Any,
-    seeds: Sequence[int],
-    jobs: int,
-    trained: Sequence[Any],
-    baseline_rows: Sequence[Mapping[str, Any]],
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The content of ``comparison.json``, and the evaluation row the DQN row reports (the
-    runs' episodes pooled when there are several seeds)."""
-    name = experiment.name
-    cfg = experiment.env_config()
-    episodes = experiment.train.eval_episodes
-    thesis_dqn = DQN_RESULTS.get(name)
+def _dqn_rows(
+    name: str, seeds: Sequence[int], trained: Sequence[Any], thesis_dqn: Mapping[str, Any] | None
+) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The DQN rows (pooled or single, each seed's, the final models under validation) and
+    the evaluation row the first of them reports."""
     # With validation (train.validate_every) each run reports its best-validated policy,
     # chosen on held-out episodes, never the protocol's; the final models are shown below.
     reported = [reported_evaluation(t) for t in trained]
-    validated = all(t.best_evaluation is not None for t in trained)
     models = [r["model"] for r in reported]
     finals = [t.evaluation["model"] for t in trained]
     several = len(seeds) > 1
@@ -243,18 +249,33 @@ def comparison_table(
             rows.append(
                 comparison_row(r["model"], "dqn", None, name=f"DQN {name}, seed {seed}{step}")
             )
-    if validated:
+    if _validated(trained):
         label = f"DQN {name}, final model{'s' if several else ''}"
         final_row = pool_evaluations(finals, label) if several else finals[0]
         rows.append(comparison_row(final_row, "dqn", None, name=label))
+    return rows, dqn_row
+
+
+def _validated(trained: Sequence[Any]) -> bool:
+    """Whether every run reports a best-validated policy."""
+    return all(t.best_evaluation is not None for t in trained)
+
+
+def _heuristic_rows(baseline_rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    rows = []
     for row in baseline_rows:
         thesis = None
         if row.get("thesis_mean") is not None:
             thesis = {"mean": row["thesis_mean"], "std": row["thesis_std"], "episodes": 30}
         rows.append(comparison_row(row, "heuristic", thesis))
+    return rows
 
+
+def _training_runs(seeds: Sequence[int], trained: Sequence[Any]) -> list[dict[str, Any]]:
+    """One entry per run: its folder, steps, wall time, speed and reported policy."""
     runs = []
-    for seed, t, r in zip(seeds, trained, reported, strict=True):
+    for seed, t in zip(seeds, trained, strict=True):
+        r = reported_evaluation(t)
         wall = training_wall_time(t.run_dir) or t.wall_time_s
         runs.append(
             {
@@ -268,46 +289,77 @@ def comparison_table(
                 "final_mean_reward": float(t.evaluation["model"]["mean_reward"]),
             }
         )
+    return runs
+
+
+def _setting(experiment: Any) -> dict[str, Any]:
+    """The evaluation setting: map, sensor, reward and episodes."""
+    cfg = experiment.env_config()
+    episodes = experiment.train.eval_episodes
+    return {
+        "preset": experiment.env.get("preset", "thesis-20x20"),
+        "height": cfg.height,
+        "width": cfg.width,
+        "perception_range": cfg.perception_range,
+        "map_mode": cfg.map_mode,
+        "map_seed": cfg.map_seed,
+        "reward": cfg.reward.kind,
+        "episodes": episodes,
+        "seeds": [0, episodes - 1],
+        "deterministic": True,
+    }
+
+
+def _training(
+    experiment: Any, seeds: Sequence[int], jobs: int, trained: Sequence[Any]
+) -> dict[str, Any]:
+    """The training: config, seeds, budget against the thesis's, and each run."""
+    return {
+        "config": experiment.name,
+        "description": experiment.description,
+        "reported_policy": (
+            "best-validated policy (chosen on held-out episodes, never the protocol's)"
+            if _validated(trained)
+            else "final model"
+        ),
+        "seeds": list(seeds),
+        "jobs": jobs,
+        "steps": min(t.num_timesteps for t in trained),
+        "thesis_steps": (DQN_RESULTS.get(experiment.name) or {}).get("steps", 1_000_000),
+        "runs": _training_runs(seeds, trained),
+        "source": experiment.source,
+    }
+
+
+def comparison_table(
+    experiment: Any,
+    seeds: Sequence[int],
+    jobs: int,
+    trained: Sequence[Any],
+    baseline_rows: Sequence[Mapping[str, Any]],
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The content of ``comparison.json``, and the evaluation row the DQN row reports (the
+    runs' episodes pooled when there are several seeds)."""
+    name = experiment.name
+    rows, dqn_row = _dqn_rows(name, seeds, trained, DQN_RESULTS.get(name))
+    rows += _heuristic_rows(baseline_rows)
+    models = [reported_evaluation(t)["model"] for t in trained]
     spread = seed_spread(seeds, models)
+    training = _training(experiment, seeds, jobs, trained)
     table = {
         "title": f"Thesis comparison: {name} (DQN) and the heuristic baselines",
-        "setting": {
-            "preset": experiment.env.get("preset", "thesis-20x20"),
-            "height": cfg.height,
-            "width": cfg.width,
-            "perception_range": cfg.perception_range,
-            "map_mode": cfg.map_mode,
-            "map_seed": cfg.map_seed,
-            "reward": cfg.reward.kind,
-            "episodes": episodes,
-            "seeds": [0, episodes - 1],
-            "deterministic": True,
-        },
-        "training": {
-            "config": name,
-            "description": experiment.description,
-            "reported_policy": (
-                "best-validated policy (chosen on held-out episodes, never the protocol's)"
-                if validated
-                else "final model"
-            ),
-            "seeds": list(seeds),
-            "jobs": jobs,
-            "steps": min(t.num_timesteps for t in trained),
-            "thesis_steps": (thesis_dqn or {}).get("steps", 1_000_000),
-            "runs": runs,
-            "source": experiment.source,
-        },
+        "setting": _setting(experiment),
+        "training": training,
         "summaries": [
             summary_row(
-                r,
+                reported_evaluation(t),
                 config=name,
                 seed=seed,
                 steps=t.num_timesteps,
                 wall_time_s=run["wall_time_s"],
                 run_dir=t.run_dir,
             )
-            for seed, t, r, run in zip(seeds, trained, reported, runs, strict=True)
+            for seed, t, run in zip(seeds, trained, training["runs"], strict=True)
         ],
         "seed_spread": spread,
         "rows": rows,
