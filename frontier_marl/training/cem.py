@@ -24,6 +24,7 @@ import json
 import math
 import time
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -192,41 +193,42 @@ def set_weights(model: Any, weights: np.ndarray) -> None:
             network.q_net.weight.copy_(value)
 
 
-def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) -> TrainResult:
-    """Run CEM for ``experiment`` into ``run_dir`` (summary in ``RUN/cem.json``, one record
-    per generation in ``RUN/cem.jsonl``)."""
-    settings, cem = experiment.train, CEMSettings(**experiment.cem)
-    configs = experiment.env_configs()
-    cfg = configs[0]
-    names = feature_names(cfg)
-    mean = initial_weights(cem, names)
-    sigma = np.full(len(names), float(cem.sigma))
-    fixed = names.index("path")
-    sigma[fixed] = 0.0
-    reference_weights = np.zeros(len(names))
-    reference_weights[fixed] = mean[fixed]
-    rng = np.random.default_rng(settings.seed)
-    ranges = [family(name).train for name in settings.families]
-    model = linear_model(cfg, mean, settings.device)
-    model.num_timesteps = 0
+@dataclass
+class _CEMSearch:
+    """The search distribution: the weights' mean and spread (none on the fixed path weight)."""
 
-    def metadata() -> dict[str, Any]:
-        return linear_metadata(model, cfg, experiment, seed=settings.seed, trained_by="cem")
+    mean: np.ndarray
+    sigma: np.ndarray
+    fixed: int
+    reference_weights: np.ndarray  # the path-only scorer every candidate is compared with
 
-    run_dir.mkdir(parents=True, exist_ok=True)
-    validator = FamilyValidator(settings.families, settings.validation_episodes, cfg)
-    keeper = BestPolicyKeeper(run_dir, cfg, settings, metadata, 0, validator)
-    log = run_dir / LOG_FILE
-    log.write_text("")
-    started, cpu_started = time.perf_counter(), time.process_time()
-    bar = make_bar(cem.generations, disable=not progress_bar, desc="cem", unit="gen")
-    for generation in range(cem.generations):
+    @classmethod
+    def start(cls, cem: CEMSettings, names: list[str]) -> _CEMSearch:
+        mean = initial_weights(cem, names)
+        sigma = np.full(len(names), float(cem.sigma))
+        fixed = names.index("path")
+        sigma[fixed] = 0.0
+        reference_weights = np.zeros(len(names))
+        reference_weights[fixed] = mean[fixed]
+        return cls(mean, sigma, fixed, reference_weights)
+
+    def generation(
+        self,
+        cem: CEMSettings,
+        rng: np.random.Generator,
+        configs: list[EnvConfig],
+        ranges: list[Any],
+        model: Any,
+    ) -> list[float]:
+        """Score ``population`` candidates on fresh episodes and move to the elite; the
+        candidates' scores (the mean's first). Adds the decisions played to ``model``'s."""
         seeds = [[int(s) for s in rng.choice(r, cem.episodes, replace=False)] for r in ranges]
         reference = [
-            play_t99(c, s, reference_weights)[0] for c, s in zip(configs, seeds, strict=True)
+            play_t99(c, s, self.reference_weights)[0] for c, s in zip(configs, seeds, strict=True)
         ]
-        candidates = [mean] + [
-            mean + sigma * rng.standard_normal(len(names)) for _ in range(cem.population - 1)
+        size = len(self.mean)
+        candidates = [self.mean] + [
+            self.mean + self.sigma * rng.standard_normal(size) for _ in range(cem.population - 1)
         ]
         scores = []
         for weights in candidates:
@@ -234,28 +236,68 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
             scores.append(score)
             model.num_timesteps += decisions
         elite = np.array([candidates[i] for i in np.argsort(scores)[: cem.elite]])
-        mean = elite.mean(axis=0)
-        sigma = np.maximum(elite.std(axis=0), cem.min_sigma)
-        sigma[fixed] = 0.0
-        set_weights(model, mean)
-        score = keeper(model)
+        self.mean = elite.mean(axis=0)
+        self.sigma = np.maximum(elite.std(axis=0), cem.min_sigma)
+        self.sigma[self.fixed] = 0.0
+        return scores
+
+
+@dataclass
+class _CEMRun:
+    """One CEM training run: its settings, model, log and start times."""
+
+    experiment: Experiment
+    run_dir: Path
+    cem: CEMSettings
+    configs: list[EnvConfig]
+    model: Any
+    started: float = 0.0
+    cpu_started: float = 0.0
+
+    @property
+    def log(self) -> Path:
+        return self.run_dir / LOG_FILE
+
+    def metadata(self) -> dict[str, Any]:
+        seed = self.experiment.train.seed
+        return linear_metadata(
+            self.model, self.configs[0], self.experiment, seed=seed, trained_by="cem"
+        )
+
+    def start(self) -> BestPolicyKeeper:
+        """Create the run folder and an empty log, start the clocks; the keeper of the best
+        validated mean."""
+        settings = self.experiment.train
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        cfg = self.configs[0]
+        validator = FamilyValidator(settings.families, settings.validation_episodes, cfg)
+        keeper = BestPolicyKeeper(self.run_dir, cfg, settings, self.metadata, 0, validator)
+        self.log.write_text("")
+        self.started, self.cpu_started = time.perf_counter(), time.process_time()
+        return keeper
+
+    def record(self, generation: int, scores: list[float], score: float) -> None:
+        """Append one generation's record to the log."""
         record = {
             "generation": generation,
-            "decisions": model.num_timesteps,
+            "decisions": self.model.num_timesteps,
             "mean_vs_path_scorer": scores[0],
             "best_vs_path_scorer": min(scores),
             "validation_vs_nearest_path": -score,
-            "weights": metadata()["weights"],
-            "wall_s": time.perf_counter() - started,
+            "weights": self.metadata()["weights"],
+            "wall_s": time.perf_counter() - self.started,
         }
-        with log.open("a") as handle:
+        with self.log.open("a") as handle:
             handle.write(json.dumps(record) + "\n")
-        bar.update(1)
-        bar.set_postfix(validation=f"{-score:+.1%}")
-    bar.close()
-    wall = time.perf_counter() - started
+
+
+def _finish(run: _CEMRun, best: float) -> TrainResult:
+    """Save the last mean and its metadata, the summary (``best``: the best validation score)
+    and the validation plot."""
+    model, run_dir, cem = run.model, run.run_dir, run.cem
+    wall = time.perf_counter() - run.started
     model.save(run_dir / "model.zip")
-    meta = metadata()
+    meta = run.metadata()
     meta["training"] = {"wall_time_s": wall, "generations": cem.generations}
     save_metadata(meta, run_dir / "model.json")
     summary = {
@@ -263,14 +305,15 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
         "generations": cem.generations,
         "decisions": model.num_timesteps,
         "wall_time_s": wall,
-        "best_validation": None if math.isinf(keeper.best_score) else -keeper.best_score,
+        "best_validation": None if math.isinf(best) else -best,
         "weights": meta["weights"],
     }
     (run_dir / "cem.json").write_text(json.dumps(summary, indent=2) + "\n")
     plot_family_validation(
         read_validation_log(run_dir),
         run_dir / "validation_t99.png",
-        title=f"{experiment.name} (seed {settings.seed}, {cem.generations} generations)",
+        title=f"{run.experiment.name} (seed {run.experiment.train.seed}, "
+        f"{cem.generations} generations)",
         xlabel="decisions played in training (CEM)",
     )
     model_path = run_dir / "model.zip"
@@ -280,7 +323,31 @@ def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) 
         num_timesteps=model.num_timesteps,
         steps_this_session=model.num_timesteps,
         wall_time_s=wall,
-        cpu_time_s=time.process_time() - cpu_started,
+        cpu_time_s=time.process_time() - run.cpu_started,
         interrupted=False,
-        files={"model": model_path, "metadata": run_dir / "model.json", "log": log},
+        files={"model": model_path, "metadata": run_dir / "model.json", "log": run.log},
     )
+
+
+def train_cem(experiment: Experiment, run_dir: Path, progress_bar: bool = True) -> TrainResult:
+    """Run CEM for ``experiment`` into ``run_dir`` (summary in ``RUN/cem.json``, one record
+    per generation in ``RUN/cem.jsonl``)."""
+    settings, cem = experiment.train, CEMSettings(**experiment.cem)
+    configs = experiment.env_configs()
+    search = _CEMSearch.start(cem, feature_names(configs[0]))
+    rng = np.random.default_rng(settings.seed)
+    ranges = [family(name).train for name in settings.families]
+    model = linear_model(configs[0], search.mean, settings.device)
+    model.num_timesteps = 0
+    run = _CEMRun(experiment, run_dir, cem, configs, model)
+    keeper = run.start()
+    bar = make_bar(cem.generations, disable=not progress_bar, desc="cem", unit="gen")
+    for generation in range(cem.generations):
+        scores = search.generation(cem, rng, configs, ranges, model)
+        set_weights(model, search.mean)
+        score = keeper(model)
+        run.record(generation, scores, score)
+        bar.update(1)
+        bar.set_postfix(validation=f"{-score:+.1%}")
+    bar.close()
+    return _finish(run, keeper.best_score)
