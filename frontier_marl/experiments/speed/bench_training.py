@@ -20,7 +20,11 @@ import json
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import stable_baselines3
 from scipy import ndimage
@@ -31,7 +35,8 @@ from frontier_marl.envs import parallel
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.sim import engine
 from frontier_marl.training import vec_env as vec_module
-from frontier_marl.training.experiment import load_experiment
+from frontier_marl.training.experiment import Experiment, load_experiment
+from frontier_marl.training.results import TrainResult
 from frontier_marl.training.train import train
 
 
@@ -71,7 +76,7 @@ def stage_functions() -> list[tuple[object, str]]:
     ]
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("config", nargs="?", default="config01")
     parser.add_argument("--steps", type=int, default=20_000)
@@ -79,8 +84,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--set", dest="overrides", action="append", default=[])
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--stages", action="store_true", help="time the stages of a step too")
-    args = parser.parse_args(argv)
-    experiment = load_experiment(
+    return parser.parse_args(argv)
+
+
+def _experiment(args: argparse.Namespace) -> Experiment:
+    """The config with the benchmark's budget and seed, no evaluation or checkpoints."""
+    return load_experiment(
         args.config,
         [
             *args.overrides,
@@ -91,35 +100,52 @@ def main(argv: list[str] | None = None) -> int:
             "train.vec_env=supersuit",  # the layers timed below are SuperSuit's
         ],
     )
-    env_timer, vec_timer, grad_timer = Timer(), Timer(), Timer()
+
+
+@dataclass
+class _Timers:
+    """The env step, the vector layers' step, the gradient steps and (``--stages``) the stages."""
+
+    env: Timer = field(default_factory=Timer)
+    vec: Timer = field(default_factory=Timer)
+    grad: Timer = field(default_factory=Timer)
+    stages: dict[str, Timer] = field(default_factory=dict)
+
+
+@contextmanager
+def _timed(stages: bool) -> Iterator[_Timers]:
+    """Wrap the timed functions in timers while the block runs; restore them afterwards."""
+    timers = _Timers()
     originals = (FrontierParallelEnv.step, DQN.train, vec_module.make_vec_env)
-    FrontierParallelEnv.step = env_timer.wrap(FrontierParallelEnv.step)
-    DQN.train = grad_timer.wrap(DQN.train)
+    FrontierParallelEnv.step = timers.env.wrap(FrontierParallelEnv.step)
+    DQN.train = timers.grad.wrap(DQN.train)
 
     def make_timed_vec_env(*a, **kw):  # noqa: ANN002, ANN003, ANN202
         vec = originals[2](*a, **kw)
-        vec.step_wait = vec_timer.wrap(vec.step_wait)
+        vec.step_wait = timers.vec.wrap(vec.step_wait)
         return vec
 
     vec_module.make_vec_env = make_timed_vec_env
-    stage_timers: dict[str, Timer] = {}
     patched: list[tuple[object, str, object]] = []
-    if args.stages:
+    if stages:
         for owner, name in stage_functions():
-            timer = stage_timers[name if owner is not ndimage else "ndimage.label"] = Timer()
+            timer = timers.stages[name if owner is not ndimage else "ndimage.label"] = Timer()
             original = getattr(owner, name)
             patched.append((owner, name, original))
             setattr(owner, name, timer.wrap(original))
     try:
-        with tempfile.TemporaryDirectory() as tmp:
-            result = train(experiment, Path(tmp) / "run", progress_bar=False)
+        yield timers
     finally:
         FrontierParallelEnv.step, DQN.train, vec_module.make_vec_env = originals
         for owner, name, original in patched:
             setattr(owner, name, original)
 
+
+def _report(experiment: Experiment, result: TrainResult, timers: _Timers) -> dict[str, Any]:
+    """Speed, time shares and per-call costs of the run, and versions."""
     wall, cpu, steps = result.wall_time_s, result.cpu_time_s, result.steps_this_session
-    report = {
+    env, vec, grad = timers.env, timers.vec, timers.grad
+    return {
         "config": experiment.name,
         "steps": steps,
         "wall_time_s": round(wall, 2),
@@ -127,26 +153,33 @@ def main(argv: list[str] | None = None) -> int:
         "steps_per_second_wall": round(steps / wall, 1),
         "steps_per_second_cpu": round(steps / cpu, 1),
         "projected_1e6_minutes_cpu": round(1e6 / (steps / cpu) / 60, 1),
-        "share_env": round(env_timer.seconds / wall, 3),
-        "share_vector_layers": round((vec_timer.seconds - env_timer.seconds) / wall, 3),
-        "share_gradient_steps": round(grad_timer.seconds / wall, 3),
-        "share_rest_of_sb3": round(1 - (vec_timer.seconds + grad_timer.seconds) / wall, 3),
-        "us_per_env_step": round(env_timer.seconds / max(env_timer.calls, 1) * 1e6, 1),
-        "us_per_gradient_step": round(grad_timer.seconds / max(grad_timer.calls, 1) * 1e6, 1),
+        "share_env": round(env.seconds / wall, 3),
+        "share_vector_layers": round((vec.seconds - env.seconds) / wall, 3),
+        "share_gradient_steps": round(grad.seconds / wall, 3),
+        "share_rest_of_sb3": round(1 - (vec.seconds + grad.seconds) / wall, 3),
+        "us_per_env_step": round(env.seconds / max(env.calls, 1) * 1e6, 1),
+        "us_per_gradient_step": round(grad.seconds / max(grad.calls, 1) * 1e6, 1),
         "torch_threads": experiment.train.torch_threads,
         "stable_baselines3": stable_baselines3.__version__,
         "python": sys.version.split()[0],
     }
-    report["stages"] = {  # without each stage's first call (one-time costs, kernel loading)
+
+
+def _stage_report(timers: _Timers) -> dict[str, dict[str, Any]]:
+    """Each stage's calls and costs, without its first call (one-time costs, kernel loading)."""
+    return {
         name: {
             "calls": max(timer.calls - 1, 0),
             "us_per_call": round(later / max(timer.calls - 1, 1) * 1e6, 1),
-            "us_per_env_step": round(later / max(env_timer.calls, 1) * 1e6, 1),
+            "us_per_env_step": round(later / max(timers.env.calls, 1) * 1e6, 1),
             "first_call_ms": round(timer.first_call_seconds * 1e3, 1),
         }
-        for name, timer in stage_timers.items()
+        for name, timer in timers.stages.items()
         for later in [timer.seconds - timer.first_call_seconds]
     }
+
+
+def _print_report(report: dict[str, Any]) -> None:
     for key, value in report.items():
         if key != "stages":
             print(f"{key:>28}: {value}")
@@ -156,6 +189,16 @@ def main(argv: list[str] | None = None) -> int:
             f"({row['calls']} calls, {row['us_per_call']} µs each; "
             f"first call {row['first_call_ms']} ms, not counted)"
         )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parse_args(argv)
+    experiment = _experiment(args)
+    with _timed(args.stages) as timers, tempfile.TemporaryDirectory() as tmp:
+        result = train(experiment, Path(tmp) / "run", progress_bar=False)
+    report = _report(experiment, result, timers)
+    report["stages"] = _stage_report(timers)
+    _print_report(report)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2) + "\n")
     return 0
