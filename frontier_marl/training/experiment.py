@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -131,66 +131,23 @@ def dqn_keys() -> set[str]:
 def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> Experiment:
     """Build and validate an :class:`Experiment` from a parsed config file."""
     where = f" in {source}" if source else ""
-    unknown = set(data) - {"name", "description", *SECTIONS}
-    if unknown:
-        raise ValueError(
-            f"unknown top-level key(s) {sorted(unknown)}{where}; "
-            "allowed: name, description, [env], [dqn], [ppo], [train], [cem], [regression]"
-        )
-    name = data.get("name")
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"an experiment needs a non-empty string 'name'{where}")
-    for section in SECTIONS:
-        if not isinstance(data.get(section, {}), Mapping):
-            raise ValueError(f"[{section}] must be a table{where}")
-    env = dict(data.get("env", {}))
-    map_name = env.get("map_path")
-    if isinstance(map_name, str) and map_name in EXAMPLE_MAPS:  # e.g. "rooms-64"
-        env["map_path"] = str(example_map_path(map_name))  # a shipped example map by name
-    dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
+    name = _checked_name(data, where)
+    env = _env_section(data)
     train_kw = dict(data.get("train", {}))
     for key in ("families", "agents"):
         if isinstance(train_kw.get(key), list):
             train_kw[key] = tuple(train_kw[key])
-    bad_train = set(train_kw) - TRAIN_KEYS
-    if bad_train:
-        raise ValueError(
-            f"unknown [train] key(s) {sorted(bad_train)}{where}; allowed: {sorted(TRAIN_KEYS)}"
-        )
-    bad_dqn = set(dqn) - dqn_keys()
-    if bad_dqn:
-        raise ValueError(
-            f"unknown or reserved [dqn] key(s) {sorted(bad_dqn)}{where}; "
-            f"allowed: {sorted(dqn_keys())} (seed and device are set in [train])"
-        )
+    _check_keys("train", train_kw, TRAIN_KEYS, where)
+    dqn = {**THESIS_DQN, **dict(data.get("dqn", {}))}
+    _check_keys("dqn", dqn, dqn_keys(), where, reserved=True)
     DQN.check_ranges(dqn, where)
     settings = TrainSettings(**train_kw)
-    ppo = dict(data.get("ppo", {}))
-    _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
-    if ppo:
-        algorithm = SB3_ALGORITHMS[settings.algorithm]
-        allowed = algorithm.keyword_names()
-        unknown = set(ppo) - allowed
-        if unknown:
-            raise ValueError(
-                f"unknown or reserved [ppo] key(s) {sorted(unknown)}{where}; "
-                f"allowed: {sorted(allowed)} (seed and device are set in [train])"
-            )
-        algorithm.check_ranges(ppo, where)
+    ppo = _ppo_section(data, settings, where)
     cem = dict(data.get("cem", {}))
-    bad_cem = set(cem) - CEM_KEYS
-    if bad_cem:
-        raise ValueError(
-            f"unknown [cem] key(s) {sorted(bad_cem)}{where}; allowed: {sorted(CEM_KEYS)}"
-        )
+    _check_keys("cem", cem, CEM_KEYS, where)
     CEMSettings(**cem)  # raises naming a bad value
     regression = dict(data.get("regression", {}))
-    bad_regression = set(regression) - REGRESSION_KEYS
-    if bad_regression:
-        raise ValueError(
-            f"unknown [regression] key(s) {sorted(bad_regression)}{where}; "
-            f"allowed: {sorted(REGRESSION_KEYS)}"
-        )
+    _check_keys("regression", regression, REGRESSION_KEYS, where)
     RegressionSettings(**regression)
     if isinstance(dqn.get("train_freq"), list):
         dqn["train_freq"] = tuple(dqn["train_freq"])  # SB3 wants (n, "step"|"episode")
@@ -205,6 +162,65 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         ppo=ppo,
         source=source,
     )
+    _check_built(experiment, where)
+    return experiment
+
+
+def _checked_name(data: Mapping[str, Any], where: str) -> str:
+    """The experiment's name, after checking the top-level keys and that sections are tables."""
+    unknown = set(data) - {"name", "description", *SECTIONS}
+    if unknown:
+        raise ValueError(
+            f"unknown top-level key(s) {sorted(unknown)}{where}; "
+            "allowed: name, description, [env], [dqn], [ppo], [train], [cem], [regression]"
+        )
+    name = data.get("name")
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"an experiment needs a non-empty string 'name'{where}")
+    for section in SECTIONS:
+        if not isinstance(data.get(section, {}), Mapping):
+            raise ValueError(f"[{section}] must be a table{where}")
+    return name
+
+
+def _env_section(data: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``[env]`` keywords, a shipped example map named in ``map_path`` made a path."""
+    env = dict(data.get("env", {}))
+    map_name = env.get("map_path")
+    if isinstance(map_name, str) and map_name in EXAMPLE_MAPS:  # e.g. "rooms-64"
+        env["map_path"] = str(example_map_path(map_name))  # a shipped example map by name
+    return env
+
+
+def _check_keys(
+    section: str, keys: Iterable[str], allowed: Collection[str], where: str, reserved: bool = False
+) -> None:
+    """Refuse keys of ``[section]`` outside ``allowed`` (``reserved``: seed and device, which
+    [train] sets, are not allowed either)."""
+    bad = set(keys) - set(allowed)
+    if not bad:
+        return
+    if reserved:
+        raise ValueError(
+            f"unknown or reserved [{section}] key(s) {sorted(bad)}{where}; "
+            f"allowed: {sorted(allowed)} (seed and device are set in [train])"
+        )
+    raise ValueError(f"unknown [{section}] key(s) {sorted(bad)}{where}; allowed: {sorted(allowed)}")
+
+
+def _ppo_section(data: Mapping[str, Any], settings: TrainSettings, where: str) -> dict[str, Any]:
+    """The ``[ppo]`` keywords, checked against the algorithm (none unless it is a PPO)."""
+    ppo = dict(data.get("ppo", {}))
+    _check_sections(settings.algorithm, bool(data.get("dqn")), bool(ppo), where)
+    if ppo:
+        algorithm = SB3_ALGORITHMS[settings.algorithm]
+        _check_keys("ppo", ppo, algorithm.keyword_names(), where, reserved=True)
+        algorithm.check_ranges(ppo, where)
+    return ppo
+
+
+def _check_built(experiment: Experiment, where: str) -> None:
+    """Refuse an experiment whose env config or hyperparameters cannot be built."""
     try:
         experiment.env_config()
     except ValueError as exc:
@@ -213,7 +229,6 @@ def experiment_from_dict(data: Mapping[str, Any], source: str | None = None) -> 
         experiment.hyperparameters()
     except ValueError as exc:
         raise ValueError(f"[ppo]{where}: {exc}") from exc
-    return experiment
 
 
 def _check_sections(algorithm: str, has_dqn: bool, has_ppo: bool, where: str) -> None:
