@@ -23,10 +23,12 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.cli.arguments import add_set_argument, non_negative_int, positive_int
+from frontier_marl.config import EnvConfig
 from frontier_marl.evaluation.model_evaluation import format_comparison
 from frontier_marl.policies.model_files import find_checkpoint
-from frontier_marl.training.experiment import load_experiment, parse_override
-from frontier_marl.training.settings import CEMSettings, RegressionSettings
+from frontier_marl.training.experiment import Experiment, load_experiment, parse_override
+from frontier_marl.training.results import TrainResult
+from frontier_marl.training.settings import CEMSettings, RegressionSettings, TrainSettings
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -123,19 +125,8 @@ def _resumed(args: argparse.Namespace) -> tuple[Any, Path, Any]:
     return experiment, args.out or checkpoint.run_dir, checkpoint
 
 
-def run(args: argparse.Namespace) -> int:
-    try:
-        experiment, run_dir, checkpoint = (
-            _resumed(args) if args.resume is not None else _fresh(args)
-        )
-    except ValueError as exc:
-        return _fail(str(exc))
-
-    from frontier_marl.training.train import train
-
-    cfg = experiment.env_config()
-    settings = experiment.train
-    start = "" if checkpoint is None else f", resuming at step {checkpoint.step}"
+def _worlds(cfg: EnvConfig, settings: TrainSettings) -> tuple[str, str]:
+    """The env the run trains on, and how many worlds it steps at once."""
     if settings.families:
         world = f"families {', '.join(settings.families)}, {cfg.map_mode} maps"
         worlds = f"{settings.n_envs} worlds per family"
@@ -145,6 +136,14 @@ def run(args: argparse.Namespace) -> int:
     else:
         world = f"{cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map"
         worlds = f"{settings.n_envs} world(s)"
+    return world, worlds
+
+
+def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
+    """The ``env:`` line and the budget line of the start message."""
+    cfg = experiment.env_config()
+    settings = experiment.train
+    world, worlds = _worlds(cfg, settings)
     budget = (
         f"{settings.total_timesteps} steps, seed {settings.seed}, {worlds} ({settings.vec_env})"
     )
@@ -163,22 +162,11 @@ def run(args: argparse.Namespace) -> int:
         )
     if settings.algorithm != "cost-regression":  # that one takes frontier-rule's observation
         world += f", reward={cfg.reward.kind}, observation={cfg.observation}"
-    print(
-        f"{experiment.name}: {experiment.description}\n"
-        f"  env: {world}\n"
-        f"  {budget}{start}\n"
-        f"  run folder: {run_dir}"
-    )
-    try:
-        result = train(
-            experiment,
-            run_dir,
-            resume=checkpoint,
-            progress_bar=not args.no_progress,
-            verbose=1 if args.verbose else 0,
-        )
-    except ValueError as exc:
-        return _fail(str(exc))
+    return world, budget
+
+
+def _report(result: TrainResult) -> int:
+    """Print what the training did and wrote; the exit code (130 when interrupted)."""
     print(
         f"trained {result.steps_this_session} steps in {result.wall_time_s:.1f} s "
         f"({result.steps_per_second:.0f} steps/s; CPU time {result.cpu_time_s:.1f} s); "
@@ -203,3 +191,34 @@ def run(args: argparse.Namespace) -> int:
     for label, path in result.files.items():
         print(f"  {label}: {path}")
     return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        experiment, run_dir, checkpoint = (
+            _resumed(args) if args.resume is not None else _fresh(args)
+        )
+    except ValueError as exc:
+        return _fail(str(exc))
+
+    from frontier_marl.training.train import train
+
+    world, budget = _env_and_budget(experiment)
+    start = "" if checkpoint is None else f", resuming at step {checkpoint.step}"
+    print(
+        f"{experiment.name}: {experiment.description}\n"
+        f"  env: {world}\n"
+        f"  {budget}{start}\n"
+        f"  run folder: {run_dir}"
+    )
+    try:
+        result = train(
+            experiment,
+            run_dir,
+            resume=checkpoint,
+            progress_bar=not args.no_progress,
+            verbose=1 if args.verbose else 0,
+        )
+    except ValueError as exc:
+        return _fail(str(exc))
+    return _report(result)
