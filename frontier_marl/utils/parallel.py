@@ -7,8 +7,10 @@ picklable for worker processes (module-level functions, plain data); each task s
 deterministic on its own (e.g. one episode from its seed), so the results do not depend on
 where or when it ran.
 
-Worker processes are started with ``forkserver`` (``spawn`` where there is none): never a bare
-``fork`` of a parent that may hold torch's or Ray's threads. A task that raises makes
+Worker processes are forked where that is safe (:func:`start_method`: Linux, a parent on one
+Python thread and without torch; it costs nothing), else started by ``forkserver`` (a clean
+server process forks them; each pays the imports and the compiled kernels' cache load once),
+else ``spawn``. A task that raises makes
 :func:`map_tasks` raise that exception with a note naming the task (the tasks not started are
 cancelled); a worker process that dies raises :class:`WorkerDied` naming the tasks it may have
 been running. Ray is an optional extra (``pip install "frontier-marl[ray]"``).
@@ -20,6 +22,8 @@ import multiprocessing as mp
 import os
 import pickle
 import sys
+import threading
+import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -81,22 +85,47 @@ def map_tasks(
     """
     jobs = check_jobs(jobs)
     tasks = list(tasks)
-    with progress_bar(len(tasks), disable=not progress, desc=desc, unit=unit) as bar:
-
-        def done(index: int, result: Any) -> None:
-            bar.set_postfix_str(label(tasks[index]), refresh=False)
-            bar.update(1)
-            if on_done is not None:
-                on_done(index, result)
-
+    done = _Done(tasks, label, on_done, progress, desc=desc, unit=unit)
+    try:
         if ray_address is not None:
             return _on_ray(fn, tasks, ray_address, label, done)
         if jobs == 1 or len(tasks) <= 1:
             return _here(fn, tasks, label, done)
         return _in_processes(fn, tasks, min(jobs, len(tasks)), label, done)
+    finally:
+        done.close()
 
 
-def _here(fn: Callable, tasks: list, label: Callable, done: Callable) -> list:
+class _Done:
+    """Reports finished tasks: the bar (made by :meth:`start`, once the workers exist: its
+    monitor thread would make forking unsafe) and ``on_done``."""
+
+    def __init__(
+        self, tasks: list, label: Callable, on_done: Callable | None, progress: bool, **bar: Any
+    ) -> None:
+        self.tasks, self.label, self.on_done = tasks, label, on_done
+        self.progress, self.options = progress, bar
+        self.bar: Any = None
+
+    def start(self) -> None:
+        if self.progress and self.bar is None:
+            self.bar = progress_bar(len(self.tasks), **self.options)
+
+    def __call__(self, index: int, result: Any) -> None:
+        self.start()
+        if self.bar is not None:
+            self.bar.set_postfix_str(self.label(self.tasks[index]), refresh=False)
+            self.bar.update(1)
+        if self.on_done is not None:
+            self.on_done(index, result)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _here(fn: Callable, tasks: list, label: Callable, done: _Done) -> list:
+    done.start()
     results = []
     for index, task in enumerate(tasks):
         try:
@@ -111,9 +140,13 @@ def _here(fn: Callable, tasks: list, label: Callable, done: Callable) -> list:
 # --------------------------------------------------------------------------- processes
 
 
-def _context() -> Any:
-    methods = mp.get_all_start_methods()
-    return mp.get_context("forkserver" if "forkserver" in methods else "spawn")
+def start_method() -> str:
+    """``fork`` where it is safe and instant (Linux, this process on one Python thread and
+    without torch, whose thread pools do not survive a fork), else ``forkserver`` (a clean
+    server process forks the workers), else ``spawn``."""
+    if sys.platform == "linux" and threading.active_count() == 1 and "torch" not in sys.modules:
+        return "fork"
+    return "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
 
 
 def _one_thread() -> None:
@@ -137,14 +170,17 @@ def _check_picklable(fn: Callable, tasks: list, label: Callable) -> None:
             ) from None
 
 
-def _in_processes(fn: Callable, tasks: list, jobs: int, label: Callable, done: Callable) -> list:
+def _in_processes(fn: Callable, tasks: list, jobs: int, label: Callable, done: _Done) -> list:
     _check_picklable(fn, tasks, label)
-    context = _context()
+    context = mp.get_context(start_method())
     if context.get_start_method() == "forkserver":
         context.set_forkserver_preload(["frontier_marl", getattr(fn, "__module__", "")])
     pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread)
     try:
-        futures = {pool.submit(fn, task): i for i, task in enumerate(tasks)}
+        with warnings.catch_warnings():  # Python 3.12+ warns of numpy's idle BLAS threads
+            warnings.filterwarnings("ignore", ".*fork.*", DeprecationWarning)
+            futures = {pool.submit(fn, task): i for i, task in enumerate(tasks)}
+        done.start()
         results: list[Any] = [None] * len(tasks)
         pending: set[Future] = set(futures)
         while pending:
@@ -183,7 +219,7 @@ def require_ray() -> Any:
     return ray
 
 
-def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: Callable) -> list:
+def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Done) -> list:
     ray = require_ray()
     started = not ray.is_initialized()
     if started:
@@ -199,6 +235,7 @@ def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: Call
     try:
         remote = ray.remote(num_cpus=1)(fn)
         refs = [remote.remote(task) for task in tasks]
+        done.start()
         index = {ref: i for i, ref in enumerate(refs)}
         pending = list(refs)
         results: list[Any] = [None] * len(tasks)
