@@ -10,6 +10,7 @@ from typing import Any
 from frontier_marl.config import PRESETS, make_config
 from frontier_marl.core.example_maps import example_map_names
 from frontier_marl.policies import POLICIES
+from frontier_marl.utils.parallel import default_jobs, require_ray
 from frontier_marl.utils.set_options import parse_set_options
 
 
@@ -140,6 +141,36 @@ def env_kwargs_from_args(args: argparse.Namespace) -> dict[str, Any]:
     kwargs["n_agents"] = args.agents
     make_config(**kwargs)  # validate now, with the config's own error messages
     return kwargs
+
+
+def add_parallel_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--jobs N`` and ``--ray-address ADDRESS``: where the episodes run
+    (:func:`frontier_marl.utils.parallel.map_tasks`)."""
+    parser.add_argument(
+        "--jobs",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help=f"play the episodes in N processes (default: every core, {default_jobs()} here; "
+        "1: in this process); the results do not depend on N",
+    )
+    parser.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="play the episodes on a Ray cluster instead (auto: the cluster this machine "
+        "joined with `ray start`; HOST:PORT or ray://HOST:10001: that cluster; local: a new "
+        "one here); needs the ray extra, and --jobs is then ignored",
+    )
+
+
+def check_parallel_arguments(args: argparse.Namespace) -> None:
+    """ValueError when ``--ray-address`` is given without Ray installed."""
+    if args.ray_address is not None:
+        try:
+            require_ray()
+        except ImportError as exc:
+            raise ValueError(f"--ray-address: {exc}") from None
 
 
 def fail(command: str, message: str) -> int:

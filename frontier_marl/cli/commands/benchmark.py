@@ -6,6 +6,8 @@ Examples::
     frontier-marl benchmark --families random-20 --policies nearest-path,thesis-config01
     frontier-marl benchmark --map ../shared/maps/explore-bench --json eb.json --plot eb.png
     frontier-marl benchmark --agents 3 --set cells_per_step=full
+    frontier-marl benchmark --jobs 8                         # 8 processes (default: all cores)
+    frontier-marl benchmark --ray-address auto               # on the Ray cluster of this node
 
 Prints per family and policy: success (99 % coverage before the limit), T99 and T90 (cells
 travelled, mean ± std over the episodes that got there), and the paired relative T99
@@ -22,7 +24,9 @@ import time
 from pathlib import Path
 
 from frontier_marl.cli.arguments import (
+    add_parallel_arguments,
     add_set_argument,
+    check_parallel_arguments,
     fail,
     positive_int,
 )
@@ -90,6 +94,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "an env parameter for every family and policy, e.g. --set perception_range=4 "
         "--set cells_per_step=full (repeatable)",
     )
+    add_parallel_arguments(parser)
     parser.add_argument("--json", type=Path, default=None, metavar="FILE", help="write the rows")
     parser.add_argument(
         "--plot", type=Path, default=None, metavar="FILE", help="write a PNG of T99 per family"
@@ -125,19 +130,25 @@ def run(args: argparse.Namespace) -> int:
         for fam in families:
             fam.seeds(args.episodes, args.split)
             map_families.variant_configs(fam, overrides, args.agents)
+        check_parallel_arguments(args)
     except ValueError as exc:
         return fail("benchmark", str(exc))
     start = time.perf_counter()
-    rows = bench.run_benchmark(
-        families,
-        policies,
-        args.episodes,
-        args.agents,
-        overrides,
-        progress=not args.no_progress,
-        log=lambda text: print(text, file=sys.stderr),
-        split=args.split,
-    )
+    try:
+        rows = bench.run_benchmark(
+            families,
+            policies,
+            args.episodes,
+            args.agents,
+            overrides,
+            progress=not args.no_progress,
+            log=lambda text: print(text, file=sys.stderr),
+            split=args.split,
+            jobs=args.jobs,
+            ray_address=args.ray_address,
+        )
+    except ConnectionError as exc:
+        return fail("benchmark", str(exc))
     wall = time.perf_counter() - start
     first = (
         map_families.HELDOUT_SEEDS if args.split == "heldout" else map_families.VALIDATION_SEEDS
@@ -165,6 +176,8 @@ def run(args: argparse.Namespace) -> int:
             "agents": args.agents,
             "commit": commit,
             "set": list(args.overrides),
+            "jobs": args.jobs,
+            "ray_address": args.ray_address,
         }
         write_json({"options": options, "wall_seconds": wall, "rows": rows}, args.json)
         print(f"wrote {args.json}")

@@ -24,142 +24,53 @@ Statistics (T99, T90, success, the paired difference to the best heuristic) are 
 
 from __future__ import annotations
 
-import inspect
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.config import EnvConfig, config_to_dict, make_config
+from frontier_marl.config import EnvConfig, config_to_dict
 from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.evaluation.benchmark.contenders import (
+    ORACLE,
+    Contender,
+    contenders,
+    default_commit,
+    heuristic,
+    map_model,
+    model,
+    oracle,
+)
 from frontier_marl.evaluation.benchmark.families import (
     COVERAGE,
     DEFAULT_EPISODES,
     FAMILIES,
-    OBSERVATION_KEYS,
     MapFamily,
     variant_configs,
-    world_settings,
 )
 from frontier_marl.evaluation.benchmark.stats import compare, summary_row
 from frontier_marl.evaluation.protocol import evaluate
 from frontier_marl.evaluation.records import EpisodeRecord, EvaluationResult
-from frontier_marl.policies.base import ModelPolicy, Policy, slot_table
-from frontier_marl.policies.lookahead import LookaheadOracle
+from frontier_marl.policies.base import Policy, slot_table
 from frontier_marl.policies.metadata import ModelEnvMismatchError
-from frontier_marl.policies.models import (
-    PRETRAINED,
-    check_model_env,
-    load_model,
-    map_scorer_folder,
-)
-from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
-from frontier_marl.utils.progress import progress_bar
+from frontier_marl.utils.parallel import map_tasks
 
-ORACLE = "lookahead-oracle"
-
-
-@dataclass
-class Contender:
-    """A policy of the benchmark: a heuristic (by registry name) or a learned model.
-
-    ``make`` returns a fresh :class:`~frontier_marl.evaluation.Policy`; ``config`` turns a
-    family's world config into the config this policy runs with (the same for a heuristic;
-    the model's observation settings on the same world for a model).
-    """
-
-    name: str
-    heuristic: bool
-    make: Callable[[], Any]
-    config: Callable[[EnvConfig], EnvConfig]
-
-
-def default_commit(agents: int) -> str:
-    """The heuristics' commit rule in the benchmark (see the module docstring)."""
-    return "until-progress" if agents == 1 else "none"
-
-
-def heuristic(name: str, commit: str = "until-progress") -> Contender:
-    """A heuristic of the registry, with ``commit`` where it takes one; one that reads an
-    observation layout of its own (``frontier-rule``) runs with it on the family's world."""
-    accepted = inspect.signature(POLICIES[name]).parameters
-    options = {"commit": commit} if "commit" in accepted else {}
-    own = env_settings(name)
-
-    def config(world: EnvConfig) -> EnvConfig:
-        return make_config(None, **{**world_settings(world), **own}) if own else world
-
-    return Contender(name, True, lambda: make_policy(name, 0, **options), config)
-
-
-def model(name: str) -> Contender:
-    """A saved or shipped SB3 model (``thesis-config01``, a run folder, a model.zip)."""
-    try:
-        loaded = load_model(name)
-    except Exception as exc:  # e.g. a file that is not an SB3 zip
-        raise ValueError(f"cannot load model {name}: {exc}") from exc
-    if loaded.metadata is None:
-        raise ValueError(f"model {name}: no metadata saved beside it (its observation settings)")
-    saved = config_to_dict(loaded.env_config())
-
-    def config(world: EnvConfig) -> EnvConfig:
-        own = {k: saved[k] for k in OBSERVATION_KEYS}
-        cfg = make_config(None, **{**world_settings(world), **own})
-        check_model_env(loaded, cfg)
-        return cfg
-
-    label = Path(name).stem if name.endswith(".zip") else Path(name).name
-    return Contender(label, False, lambda: ModelPolicy(loaded.model, name=label), config)
-
-
-def map_model(folder: Path, label: str) -> Contender:
-    """A saved map-aware scorer (:mod:`frontier_marl.policies.map_explorer`): it chooses among
-    frontier-rule's slots, in frontier-rule's env on each world. Needs torch."""
-    try:  # torch is the train extra's
-        from frontier_marl.policies.map_explorer import MapExplorer, load_scorer
-    except ModuleNotFoundError as exc:
-        raise ValueError(
-            f"model {label}: a map scorer needs torch ({exc.name} is not installed): "
-            "pip install 'frontier-marl[train]'"
-        ) from None
-    scorer, _ = load_scorer(folder)
-    rule = heuristic("frontier-rule")
-    return Contender(label, False, lambda: MapExplorer(scorer, label), rule.config)
-
-
-def oracle() -> Contender:
-    """``lookahead-oracle`` (:mod:`frontier_marl.policies.lookahead`): it reads the true map,
-    so it is reported beside the others but never counts as the best heuristic."""
-    return Contender(LookaheadOracle.name, False, LookaheadOracle, lambda cfg: cfg)
-
-
-def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Contender]:
-    """Heuristics by name, ``lookahead-oracle`` and models by name or path; ValueError for
-    anything else."""
-    out = []
-    for name in names:
-        if name in POLICIES:
-            out.append(heuristic(name, commit))
-        elif name == ORACLE:
-            out.append(oracle())
-        elif (folder := map_scorer_folder(name)) is not None:
-            out.append(map_model(folder, Path(name).name if Path(name).exists() else name))
-        elif name in PRETRAINED or Path(name).exists():
-            out.append(model(name))
-        else:
-            raise ValueError(
-                f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), {ORACLE}, "
-                f"a shipped model ({', '.join(PRETRAINED)}), nor a model file or run folder"
-            )
-    labels = [contender.name for contender in out]
-    repeated = sorted({label for label in labels if labels.count(label) > 1})
-    if repeated:
-        raise ValueError(
-            f"two policies share the label {', '.join(map(repr, repeated))} (a model is "
-            "labelled by its folder): copy one to a folder of another name"
-        )
-    return out
+__all__ = [
+    "ORACLE",
+    "Contender",
+    "EpisodeTask",
+    "contenders",
+    "default_commit",
+    "heuristic",
+    "map_model",
+    "model",
+    "oracle",
+    "play_episode",
+    "run_benchmark",
+    "run_family",
+    "run_on_seeds",
+]
 
 
 class _SlotWatch(Policy):
@@ -188,6 +99,91 @@ class _SlotWatch(Policy):
         return self.policy.act_team(observations, infos)
 
 
+@dataclass(frozen=True)
+class EpisodeTask:
+    """One episode of the benchmark, the unit of work: a policy on a family's world from one
+    reset seed (picklable when the contender is, see
+    :mod:`~frontier_marl.evaluation.benchmark.contenders`)."""
+
+    family: str
+    contender: Contender
+    config: EnvConfig
+    seed: int
+
+    def __str__(self) -> str:
+        return f"episode {self.seed} of {self.contender.name} on {self.family}"
+
+
+@dataclass
+class EpisodeOutcome:
+    """What :func:`play_episode` returns: the record, the saturated decisions, the seconds."""
+
+    record: EpisodeRecord
+    saturated: int
+    seconds: float
+
+
+def play_episode(task: EpisodeTask) -> EpisodeOutcome:
+    """Play ``task`` with a fresh policy in a fresh env (the same wherever it runs)."""
+    start = time.perf_counter()
+    env = FrontierParallelEnv(config=task.config)
+    policy = _SlotWatch(task.contender.make())
+    try:
+        record = evaluate(env, policy, episodes=1, seed=task.seed).episodes[0]
+    finally:
+        env.close()
+    return EpisodeOutcome(record, policy.saturated, time.perf_counter() - start)
+
+
+@dataclass
+class _Plan:
+    """One (family, policy) pair of a run: its configs (one per world) and its episodes."""
+
+    family: MapFamily
+    contender: Contender
+    configs: list[EnvConfig]
+    tasks: list[EpisodeTask]
+
+
+def _plan(
+    fam: MapFamily, contender: Contender, worlds: Sequence[EnvConfig], episodes: int, split: str
+) -> _Plan:
+    """The episodes of ``contender`` on ``fam``; episode ``i`` on world ``i mod len(worlds)``
+    (ModelEnvMismatchError if the policy cannot act there)."""
+    configs = [contender.config(world) for world in worlds]
+    seeds = fam.seeds(episodes, split)
+    tasks = [
+        EpisodeTask(fam.name, contender, configs[i % len(configs)], seed)
+        for i, seed in enumerate(seeds)
+    ]
+    return _Plan(fam, contender, configs, tasks)
+
+
+def _result(plan: _Plan, outcomes: Sequence[EpisodeOutcome]) -> EvaluationResult:
+    """The plan's :class:`EvaluationResult`; its ``extra`` holds the family, maps and seeds."""
+    configs = plan.configs
+    result = EvaluationResult(
+        policy=plan.contender.name,
+        seed=plan.tasks[0].seed,
+        n_slots=configs[0].n_slots,
+        n_agents=configs[0].n_agents,
+        coverage_levels=(0.90, COVERAGE),
+        episodes=[outcome.record for outcome in outcomes],
+        config=config_to_dict(configs[0]),
+        map_mode=configs[0].map_mode,
+    )
+    maps = [task.config.map_path for task in plan.tasks]
+    result.extra.update(
+        family=plan.family.name,
+        heuristic=plan.contender.heuristic,
+        maps=[Path(m).name for m in plan.family.maps],
+        episode_maps=[None if m is None else Path(m).name for m in maps],
+        saturated_decisions=sum(outcome.saturated for outcome in outcomes),
+        wall_seconds=sum(outcome.seconds for outcome in outcomes),
+    )
+    return result
+
+
 def run_family(
     fam: MapFamily,
     contender: Contender,
@@ -195,47 +191,18 @@ def run_family(
     episodes: int,
     on_episode: Callable[[EpisodeRecord], None] | None = None,
     split: str = "heldout",
+    jobs: int | None = 1,
 ) -> EvaluationResult:
     """``episodes`` episodes of ``split`` (:meth:`MapFamily.seeds`) of one policy on one
-    family (``worlds`` from :func:`variant_configs`); the result's ``extra`` holds the family,
-    maps and seeds."""
-    start = time.perf_counter()
-    seeds = fam.seeds(episodes, split)
-    configs = [contender.config(world) for world in worlds]
-    envs = [FrontierParallelEnv(config=cfg) for cfg in configs]
-    policy = _SlotWatch(contender.make())
-    records: list[EpisodeRecord] = []
-    maps: list[str | None] = []
-    try:
-        for i, seed in enumerate(seeds):
-            env = envs[i % len(envs)]
-            record = evaluate(env, policy, episodes=1, seed=seed).episodes[0]
-            records.append(record)
-            maps.append(configs[i % len(envs)].map_path)
-            if on_episode is not None:
-                on_episode(record)
-    finally:
-        for env in envs:
-            env.close()
-    result = EvaluationResult(
-        policy=contender.name,
-        seed=seeds[0],
-        n_slots=configs[0].n_slots,
-        n_agents=configs[0].n_agents,
-        coverage_levels=(0.90, COVERAGE),
-        episodes=records,
-        config=config_to_dict(configs[0]),
-        map_mode=configs[0].map_mode,
-    )
-    result.extra.update(
-        family=fam.name,
-        heuristic=contender.heuristic,
-        maps=[Path(m).name for m in fam.maps],
-        episode_maps=[None if m is None else Path(m).name for m in maps],
-        saturated_decisions=policy.saturated,
-        wall_seconds=time.perf_counter() - start,
-    )
-    return result
+    family (``worlds`` from :func:`variant_configs`), in ``jobs`` processes; the result's
+    ``extra`` holds the family, maps and seeds, ``wall_seconds`` the episodes' seconds."""
+    plan = _plan(fam, contender, worlds, episodes, split)
+
+    def done(_index: int, outcome: EpisodeOutcome) -> None:
+        if on_episode is not None:
+            on_episode(outcome.record)
+
+    return _result(plan, map_tasks(play_episode, plan.tasks, jobs, on_done=done))
 
 
 def run_benchmark(
@@ -247,35 +214,38 @@ def run_benchmark(
     progress: bool = False,
     log: Callable[[str], None] | None = None,
     split: str = "heldout",
+    jobs: int | None = 1,
+    ray_address: str | None = None,
 ) -> list[dict[str, Any]]:
     """Every policy on every family's held-out (or ``validation``) episodes; one row per
-    (family, policy) with
-    the comparison to the family's best heuristic
+    (family, policy) with the comparison to the family's best heuristic
     (:func:`~frontier_marl.evaluation.benchmark.stats.compare`). A model that cannot act on a
-    family (e.g. another map size) is skipped there, with a note to ``log``."""
+    family (e.g. another map size) is skipped there, with a note to ``log``. The episodes run
+    in ``jobs`` processes (``None``: every core) or on the Ray cluster at ``ray_address``
+    (:func:`~frontier_marl.utils.parallel.map_tasks`); the rows are the same either way."""
     if len({fam.name for fam in families}) < len(families):
         raise ValueError(f"family names must be distinct, got {[f.name for f in families]}")
     worlds = [variant_configs(fam, overrides, agents) for fam in families]
     for fam in families:
         fam.seeds(episodes, split)  # validates the episode count and the split
-    rows = []
-    total = len(families) * len(policies) * episodes
-    with progress_bar(total, disable=not progress, unit="ep") as bar:
-        for fam, configs in zip(families, worlds, strict=True):
-            for contender in policies:
-                bar.set_description(f"{fam.name} {contender.name}")
-                try:
-                    result = run_family(
-                        fam, contender, configs, episodes, lambda _r: bar.update(1), split
-                    )
-                except ModelEnvMismatchError as exc:
-                    if contender.heuristic:
-                        raise
-                    bar.update(episodes)
-                    if log is not None:
-                        log(f"{contender.name} skipped on {fam.name}: {exc}")
-                    continue
-                rows.append(summary_row(result))
+    plans = []
+    for fam, configs in zip(families, worlds, strict=True):
+        for contender in policies:
+            try:
+                plans.append(_plan(fam, contender, configs, episodes, split))
+            except ModelEnvMismatchError as exc:
+                if contender.heuristic:
+                    raise
+                if log is not None:
+                    log(f"{contender.name} skipped on {fam.name}: {exc}")
+    tasks = [task for plan in plans for task in plan.tasks]
+    outcomes = map_tasks(
+        play_episode, tasks, jobs, ray_address=ray_address, progress=progress, unit="ep"
+    )
+    rows = [
+        summary_row(_result(plan, outcomes[i * episodes : (i + 1) * episodes]))
+        for i, plan in enumerate(plans)
+    ]
     try:
         return compare(rows)
     except Exception as error:  # the statistics must never lose the episodes already run
@@ -287,12 +257,12 @@ def run_benchmark(
 
 
 def run_on_seeds(
-    names: Sequence[str], seeds: range, episodes: int, progress: bool = False
+    names: Sequence[str], seeds: range, episodes: int, progress: bool = False, jobs: int = 1
 ) -> list[dict[str, Any]]:
     """:func:`run_benchmark` of the policies ``names`` on the first ``episodes`` of ``seeds``
     of every built-in family, one robot (for the benchmark scripts that choose and probe
     models on validation or training seeds; :class:`MapFamily` refuses held-out ones)."""
     families = [replace(fam, validation=seeds) for fam in FAMILIES.values()]
     return run_benchmark(
-        families, contenders(names), episodes, progress=progress, split="validation"
+        families, contenders(names), episodes, progress=progress, split="validation", jobs=jobs
     )
