@@ -78,6 +78,49 @@ def _check_seeds(seeds: Sequence[int]) -> list[int]:
     return checked
 
 
+@dataclass(frozen=True)
+class _Plan:
+    """The checked budget of a reproduction: where, how long, which seeds, how many at once."""
+
+    out: Path
+    steps: int
+    seeds: list[int]
+    jobs: int
+    episodes: int
+
+    @classmethod
+    def checked(
+        cls, out: str | Path, steps: int, seeds: Sequence[int], jobs: int | None, episodes: int
+    ) -> _Plan:
+        """Check the arguments of :func:`reproduce` (``ValueError`` on a bad one)."""
+        steps = check_int("steps", steps, 1)
+        checked_seeds = _check_seeds(seeds)
+        jobs = len(checked_seeds) if jobs is None else check_int("jobs", jobs, 1)
+        episodes = check_int("episodes", episodes, 1)
+        return cls(Path(out), steps, checked_seeds, min(jobs, len(checked_seeds)), episodes)
+
+    @property
+    def train_settings(self) -> dict[str, Any]:
+        """The ``[train]`` settings every seed's run gets."""
+        return {"total_timesteps": self.steps, "eval_episodes": self.episodes, "eval_seed": 0}
+
+    def log_start(self, train_jobs: Sequence[Any], log: Callable[[str], None]) -> None:
+        """Log what is trained (and resumed) and how it is evaluated."""
+        experiment, seeds = train_jobs[0].experiment, self.seeds
+        at_once = "" if len(seeds) == 1 else f" ({self.jobs} runs at a time)"
+        start = "".join(
+            f", seed {job.experiment.train.seed} resuming at step {job.checkpoint.step}"
+            for job in train_jobs
+            if job.checkpoint is not None
+        )
+        log(
+            f"[1/3] training {experiment.name} ({experiment.description}): {self.steps} steps, "
+            f"seed{'s' if len(seeds) > 1 else ''} {', '.join(map(str, seeds))}{at_once}{start} "
+            f"-> {self.out}"
+        )
+        log(f"      then the thesis evaluation: {self.episodes} deterministic episodes, static map")
+
+
 def reproduce(
     out: str | Path = "runs/reproduce",
     *,
@@ -96,56 +139,49 @@ def reproduce(
     and ``resume`` is false; nothing is trained then."""
     from frontier_marl.training.workers import train_runs
 
-    steps = check_int("steps", steps, 1)
-    seeds = _check_seeds(seeds)
-    jobs = len(seeds) if jobs is None else check_int("jobs", jobs, 1)
-    episodes = check_int("episodes", episodes, 1)
-    out = Path(out)
-    settings = {"total_timesteps": steps, "eval_episodes": episodes, "eval_seed": 0}
-    train_jobs = [_train_job(config, seed, settings, out, resume, log) for seed in seeds]
+    plan = _Plan.checked(out, steps, seeds, jobs, episodes)
+    settings = plan.train_settings
+    train_jobs = [_train_job(config, s, settings, plan.out, resume, log) for s in plan.seeds]
     experiment = train_jobs[0].experiment
-    jobs = min(jobs, len(seeds))
-
-    at_once = "" if len(seeds) == 1 else f" ({jobs} runs at a time)"
-    start = "".join(
-        f", seed {job.experiment.train.seed} resuming at step {job.checkpoint.step}"
-        for job in train_jobs
-        if job.checkpoint is not None
-    )
-    log(
-        f"[1/3] training {experiment.name} ({experiment.description}): {steps} steps, "
-        f"seed{'s' if len(seeds) > 1 else ''} {', '.join(map(str, seeds))}{at_once}{start} "
-        f"-> {out}"
-    )
-    log(f"      then the thesis evaluation: {episodes} deterministic episodes, static map")
-    if jobs > 1:
+    plan.log_start(train_jobs, log)
+    if plan.jobs > 1:
         _warm_kernels(experiment)  # compile (or load) the kernels once, before the workers
-    outcome = train_runs(train_jobs, jobs, progress)
-    run_dirs = [j.run_dir for j in train_jobs]
+    outcome = train_runs(train_jobs, plan.jobs, progress)
     trained = outcome.results
     result = ReproduceResult(
-        out=out, run_dirs=run_dirs, interrupted=outcome.interrupted, trains=trained
+        out=plan.out,
+        run_dirs=[j.run_dir for j in train_jobs],
+        interrupted=outcome.interrupted,
+        trains=trained,
     )
     if outcome.interrupted or any(t is None or t.evaluation is None for t in trained):
         result.interrupted = True
         return result
-
+    episodes = plan.episodes
     log(f"[2/3] heuristic baselines on the same {episodes} episodes: {', '.join(heuristics)}")
-    env_kwargs = dict(experiment.env)
-    baseline_rows = run_baselines(env_kwargs, list(heuristics), episodes, 0, progress)
-
+    baseline_rows = run_baselines(dict(experiment.env), list(heuristics), episodes, 0, progress)
     log("[3/3] comparison table and figures")
-    table, reported = comparison_table(experiment, seeds, jobs, trained, baseline_rows)
-    result.table = table
-    files = result.files
+    result.table, reported = comparison_table(
+        experiment, plan.seeds, plan.jobs, trained, baseline_rows
+    )
+    result.files.update(_write_tables(plan.out, result.table, baseline_rows))
+    result.files.update(
+        _figures(plan.out, result.table, reported, baseline_rows, trained, experiment.name)
+    )
+    return result
+
+
+def _write_tables(
+    out: Path, table: Mapping[str, Any], baseline_rows: Sequence[Mapping[str, Any]]
+) -> dict[str, Path]:
+    """comparison.md, comparison.json and baselines.json."""
     out.mkdir(parents=True, exist_ok=True)
-    files["markdown"] = out / "comparison.md"
+    files = {"markdown": out / "comparison.md"}
     files["markdown"].write_text(format_comparison_markdown(table), encoding="utf-8")
     files["json"] = write_json(table, out / "comparison.json")
     files["baselines"] = out / "baselines.json"
     files["baselines"].write_text(dumps_rows(baseline_rows))
-    files.update(_figures(out, table, reported, baseline_rows, trained, experiment.name))
-    return result
+    return files
 
 
 def _train_job(
@@ -191,6 +227,51 @@ def _warm_kernels(experiment: Any) -> None:
     env.close()
 
 
+def _where(table: Mapping[str, Any]) -> str:
+    """The setting and the training, for the figures' titles."""
+    setting, training = table["setting"], table["training"]
+    seeds = training["seeds"]
+    return (
+        f"{setting['preset']}, {setting['map_mode']} map, {setting['episodes']} "
+        f"episodes; DQN {training['steps']} steps, seed{'s' if len(seeds) > 1 else ''} "
+        f"{', '.join(map(str, seeds))}"
+    )
+
+
+def _reward_rows(
+    table: Mapping[str, Any], reported: Mapping[str, Any], trained: Sequence[Any]
+) -> list[dict[str, Any]]:
+    """The DQN rows of the rewards figure: the reported one with the thesis's figures, and
+    each seed's when there are several."""
+    dqn = table["rows"][0]
+    seeds = table["training"]["seeds"]
+    model_row = {
+        **reported,
+        "policy": dqn["policy"],
+        "thesis_mean": dqn["thesis_mean"],
+        "thesis_std": dqn["thesis_std"],
+    }
+    seed_rows = []
+    if len(seeds) > 1:
+        seed_rows = [
+            {**reported_evaluation(t)["model"], "policy": f"DQN seed {seed}"}
+            for seed, t in zip(seeds, trained, strict=True)
+        ]
+    return [model_row, *seed_rows]
+
+
+def _reference_lines(table: Mapping[str, Any]) -> dict[str, float]:
+    """The learning curve's reference lines: the thesis's DQN and our greedy distance."""
+    dqn = table["rows"][0]
+    reference = {}
+    if dqn["thesis_mean"] is not None:
+        reference[f"thesis DQN, evaluation ({dqn['thesis_mean']:.2f})"] = dqn["thesis_mean"]
+    greedy = next((r for r in table["rows"] if r["policy"] == "greedy-distance"), None)
+    if greedy is not None:
+        reference[f"greedy-distance, ours ({greedy['mean_reward']:.2f})"] = greedy["mean_reward"]
+    return reference
+
+
 def _figures(
     out: Path,
     table: Mapping[str, Any],
@@ -201,33 +282,15 @@ def _figures(
 ) -> dict[str, Path]:
     from frontier_marl.training.callbacks import read_metrics
 
-    dqn = table["rows"][0]
-    setting, training = table["setting"], table["training"]
-    seeds = training["seeds"]
-    where = (
-        f"{setting['preset']}, {setting['map_mode']} map, {setting['episodes']} "
-        f"episodes; DQN {training['steps']} steps, seed{'s' if len(seeds) > 1 else ''} "
-        f"{', '.join(map(str, seeds))}"
-    )
-    model_row = {
-        **reported,
-        "policy": dqn["policy"],
-        "thesis_mean": dqn["thesis_mean"],
-        "thesis_std": dqn["thesis_std"],
-    }
+    dqn, training = table["rows"][0], table["training"]
+    where = _where(table)
     files = {
         "rewards_figure": out / "comparison_rewards.png",
         "actions_figure": out / "comparison_actions.png",
         "learning_curve": out / "learning_curve.png",
     }
-    seed_rows = []
-    if len(seeds) > 1:
-        seed_rows = [
-            {**reported_evaluation(t)["model"], "policy": f"DQN seed {seed}"}
-            for seed, t in zip(seeds, trained, strict=True)
-        ]
     plot_baselines(
-        [model_row, *seed_rows, *baseline_rows],
+        [*_reward_rows(table, reported, trained), *baseline_rows],
         files["rewards_figure"],
         title=f"ours beside the thesis ({where})",
     )
@@ -238,23 +301,12 @@ def _figures(
         labels=(f"ours ({training['steps']} steps)", "thesis (1e6 steps)"),
         title=f"{dqn['policy']}: share of each slot ({dqn['episodes']} deterministic episodes)",
     )
-    reference = {}
-    if dqn["thesis_mean"] is not None:
-        reference[f"thesis DQN, evaluation ({dqn['thesis_mean']:.2f})"] = dqn["thesis_mean"]
-    greedy = next((r for r in table["rows"] if r["policy"] == "greedy-distance"), None)
-    if greedy is not None:
-        reference[f"greedy-distance, ours ({greedy['mean_reward']:.2f})"] = greedy["mean_reward"]
+    curves = [
+        (f"seed {seed}", read_metrics(t.run_dir / "metrics.jsonl"), read_validation_log(t.run_dir))
+        for seed, t in zip(training["seeds"], trained, strict=True)
+    ]
+    reference = _reference_lines(table)
     plot_learning_curves(
-        [
-            (
-                f"seed {seed}",
-                read_metrics(t.run_dir / "metrics.jsonl"),
-                read_validation_log(t.run_dir),
-            )
-            for seed, t in zip(seeds, trained, strict=True)
-        ],
-        files["learning_curve"],
-        title=f"{name} ({where})",
-        reference=reference,
+        curves, files["learning_curve"], title=f"{name} ({where})", reference=reference
     )
     return files

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -133,6 +134,80 @@ def session_callbacks(
     return callbacks
 
 
+@dataclass
+class _Session:
+    """One session's model and env, and what its metadata and checkpoints record."""
+
+    algorithm: SB3Algorithm
+    experiment: Experiment
+    run_dir: Path
+    cfg: EnvConfig
+    model: Any
+    vec_env: Any
+    seed: int
+    start_step: int
+
+    def metadata(self) -> dict[str, Any]:
+        model = self.model
+        return build_metadata(
+            self.cfg,
+            model.observation_space,
+            model.action_space,
+            policy=policy_name(model.observation_space),
+            algorithm=self.algorithm.label,
+            num_timesteps=model.num_timesteps,
+            experiment=self.experiment.to_dict(),
+            extra={"seed": self.experiment.train.seed, "session_seed": self.seed},
+        )
+
+    def checkpoint_now(self, m: Any) -> Checkpoint:
+        keep = self.experiment.train.keep_checkpoints
+        return save_checkpoint(m, self.run_dir, self.metadata(), keep=keep)
+
+
+def _start(
+    algorithm: SB3Algorithm,
+    experiment: Experiment,
+    run_dir: Path,
+    checkpoint: Checkpoint | None,
+    verbose: int,
+) -> _Session:
+    """Seed the session, build its vector env and model (or resume it), set its logger."""
+    cfg = experiment.env_config()
+    start_step = 0 if checkpoint is None else checkpoint.step
+    seed = session_seed(experiment.train.seed, start_step)
+    set_random_seed(seed)
+    vec_env = training_vec_env(experiment, seed)
+    model = build_model(algorithm, experiment, vec_env, checkpoint, verbose)
+    if checkpoint is not None:
+        start_step = model.num_timesteps
+    model.action_space.seed(seed)
+    skip_repeated_mode_switches(model.policy)
+    set_logger(model, run_dir, start_step, checkpoint is not None, verbose)
+    return _Session(algorithm, experiment, run_dir, cfg, model, vec_env, seed, start_step)
+
+
+def _end(run: _Session, session: Any, result: TrainResult) -> None:
+    """Save the final checkpoint and model, record the session, plot, evaluate."""
+    model, run_dir, experiment = run.model, run.run_dir, run.experiment
+    result.files["checkpoint"] = run.checkpoint_now(model).path
+    meta = save_model(model, run.metadata(), result)
+    end_session(
+        run_dir,
+        session,
+        model.num_timesteps,
+        result.wall_time_s,
+        result.cpu_time_s,
+        result.interrupted,
+    )
+    model.logger.close()
+    run.vec_env.close()
+    result.files["learning_curve"] = plot_learning_curve(run_dir, experiment, result.num_timesteps)
+    if not result.interrupted and experiment.train.eval_episodes > 0:
+        loaded = LoadedModel(model, result.model_path, meta)
+        evaluate_session(loaded, run.cfg, experiment, run_dir, result)
+
+
 def train_sb3(
     algorithm: SB3Algorithm,
     experiment: Experiment,
@@ -147,43 +222,15 @@ def train_sb3(
     A ``KeyboardInterrupt`` raised anywhere in ``learn`` ends the session like Ctrl-C:
     checkpoint, model, no evaluation.
     """
-    settings = experiment.train
-    cfg = experiment.env_config()
-    start_step = 0 if checkpoint is None else checkpoint.step
-    seed = session_seed(settings.seed, start_step)
-    set_random_seed(seed)
-    vec_env = training_vec_env(experiment, seed)
-    model = build_model(algorithm, experiment, vec_env, checkpoint, verbose)
-    if checkpoint is not None:
-        start_step = model.num_timesteps
-    model.action_space.seed(seed)
-    skip_repeated_mode_switches(model.policy)
-    policy = policy_name(model.observation_space)
-    set_logger(model, run_dir, start_step, checkpoint is not None, verbose)
-
-    def metadata() -> dict[str, Any]:
-        return build_metadata(
-            cfg,
-            model.observation_space,
-            model.action_space,
-            policy=policy,
-            algorithm=algorithm.label,
-            num_timesteps=model.num_timesteps,
-            experiment=experiment.to_dict(),
-            extra={"seed": settings.seed, "session_seed": seed},
-        )
-
-    def checkpoint_now(m: Any) -> Checkpoint:
-        return save_checkpoint(m, run_dir, metadata(), keep=settings.keep_checkpoints)
-
+    run = _start(algorithm, experiment, run_dir, checkpoint, verbose)
+    model, start_step = run.model, run.start_step
     resumed_from = None if checkpoint is None else checkpoint.path
     session = start_session(run_dir, experiment, start_step, resumed_from)
-    periodic = session_callbacks(experiment, run_dir, metadata, checkpoint_now, start_step)
+    periodic = session_callbacks(experiment, run_dir, run.metadata, run.checkpoint_now, start_step)
     started, cpu_started = time.perf_counter(), time.process_time()
     interrupted = learn(model, experiment, checkpoint is None, callbacks, periodic, progress_bar)
     wall = time.perf_counter() - started
     cpu = time.process_time() - cpu_started
-
     result = TrainResult(
         run_dir=run_dir,
         model_path=run_dir / MODEL_FILE,
@@ -193,15 +240,7 @@ def train_sb3(
         cpu_time_s=cpu,
         interrupted=interrupted,
     )
-    result.files["checkpoint"] = checkpoint_now(model).path
-    meta = save_model(model, metadata(), result)
-    end_session(run_dir, session, model.num_timesteps, wall, cpu, interrupted)
-    model.logger.close()
-    vec_env.close()
-    result.files["learning_curve"] = plot_learning_curve(run_dir, experiment, result.num_timesteps)
-    if not interrupted and settings.eval_episodes > 0:
-        loaded = LoadedModel(model, result.model_path, meta)
-        evaluate_session(loaded, cfg, experiment, run_dir, result)
+    _end(run, session, result)
     return result
 
 

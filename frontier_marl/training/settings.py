@@ -94,6 +94,20 @@ class TrainSettings:
     algorithm: str = "dqn"
 
     def __post_init__(self) -> None:
+        self._check_integers()
+        self._check_algorithm()
+        self._check_worlds()
+        self._check_flags()
+        self._check_validation_seeds()
+        if self.eval_map_mode not in EVAL_MAP_MODES:
+            raise ValueError(
+                f"train.eval_map_mode must be one of {', '.join(EVAL_MAP_MODES)}, "
+                f"got {self.eval_map_mode!r}"
+            )
+        if not isinstance(self.device, str) or not self.device:
+            raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
+
+    def _check_integers(self) -> None:
         for name, low in (
             ("total_timesteps", 1),
             ("seed", 0),
@@ -111,6 +125,9 @@ class TrainSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"train.{name} must be an integer >= {low}, got {value!r}")
+
+    def _check_algorithm(self) -> None:
+        """The algorithm, what it needs, and the policy."""
         if self.algorithm not in ALGORITHMS:
             raise ValueError(
                 f"train.algorithm must be one of {list(ALGORITHMS)}, got {self.algorithm!r}"
@@ -125,6 +142,9 @@ class TrainSettings:
             raise ValueError("train.algorithm = 'maskable-ppo' needs train.vec_env = 'batched'")
         if self.policy not in POLICIES:
             raise ValueError(f"train.policy must be one of {list(POLICIES)}, got {self.policy!r}")
+
+    def _check_worlds(self) -> None:
+        """The families, the team sizes and the vector env."""
         if self.families:
             from frontier_marl.evaluation.benchmark.families import check_families
 
@@ -139,29 +159,28 @@ class TrainSettings:
             raise ValueError("train.agents needs train.families (the team sizes of their worlds)")
         if self.vec_env not in VEC_ENVS:
             raise ValueError(f"train.vec_env must be one of {list(VEC_ENVS)}, got {self.vec_env!r}")
+
+    def _check_flags(self) -> None:
         for name in ("bootstrap_truncations", "skip_forced_steps"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"train.{name} must be true or false, got {getattr(self, name)!r}")
         if self.skip_forced_steps and self.vec_env != "batched":
             raise ValueError("train.skip_forced_steps needs train.vec_env = 'batched'")
-        if self.validate_every and self.eval_episodes:
-            first = self.validation_seed
-            validation = range(first, first + self.validation_episodes)
-            evaluation = range(self.eval_seed, self.eval_seed + self.eval_episodes)
-            if validation.start < evaluation.stop and evaluation.start < validation.stop:
-                raise ValueError(
-                    f"train.validation_seed: validation episodes (seeds {validation.start}.."
-                    f"{validation.stop - 1}) overlap the evaluation episodes (seeds "
-                    f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
-                    "on the evaluation episodes would bias the evaluation"
-                )
-        if self.eval_map_mode not in EVAL_MAP_MODES:
+
+    def _check_validation_seeds(self) -> None:
+        """Validation episodes must not overlap the evaluation's."""
+        if not (self.validate_every and self.eval_episodes):
+            return
+        first = self.validation_seed
+        validation = range(first, first + self.validation_episodes)
+        evaluation = range(self.eval_seed, self.eval_seed + self.eval_episodes)
+        if validation.start < evaluation.stop and evaluation.start < validation.stop:
             raise ValueError(
-                f"train.eval_map_mode must be one of {', '.join(EVAL_MAP_MODES)}, "
-                f"got {self.eval_map_mode!r}"
+                f"train.validation_seed: validation episodes (seeds {validation.start}.."
+                f"{validation.stop - 1}) overlap the evaluation episodes (seeds "
+                f"{evaluation.start}..{evaluation.stop - 1}); choosing the best policy "
+                "on the evaluation episodes would bias the evaluation"
             )
-        if not isinstance(self.device, str) or not self.device:
-            raise ValueError(f"train.device must be a torch device name, got {self.device!r}")
 
 
 TRAIN_KEYS = {f.name for f in dataclasses.fields(TrainSettings)}
