@@ -3,19 +3,24 @@
 The episodes are run by :func:`frontier_marl.evaluation.evaluate` (one protocol for models and
 heuristics); the SB3 model acts through :class:`frontier_marl.evaluation.ModelPolicy` with
 ``deterministic=True`` (epsilon = 0). Before any episode the model is checked against the env
-(:func:`~frontier_marl.policies.metadata.check_compatible`).
+(:func:`~frontier_marl.policies.metadata.check_compatible`). Each episode is a task of its own
+(:class:`EvaluationTask`), so the episodes can run in worker processes or on a Ray cluster.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
-from frontier_marl.evaluation import evaluate
+from frontier_marl.evaluation.model_refs import ModelRef, source_of
+from frontier_marl.evaluation.protocol import evaluate
+from frontier_marl.evaluation.records import EvaluationResult
 from frontier_marl.policies import ModelPolicy, make_policy
 from frontier_marl.policies.metadata import env_config_from_metadata
 from frontier_marl.policies.models import LoadedModel, check_model_env
+from frontier_marl.utils.parallel import map_tasks
 
 #: An action taken in more than this share of all decisions flags a degenerate policy.
 DEGENERACY_THRESHOLD = 0.9
@@ -39,6 +44,30 @@ def degeneracy(shares: Sequence[float], threshold: float = DEGENERACY_THRESHOLD)
     }
 
 
+@dataclass(frozen=True)
+class EvaluationTask:
+    """One episode of :func:`evaluate_model`, the unit of work: the model (``model`` set) or
+    the heuristic ``policy`` (seeded with ``policy_seed``) from reset seed ``seed``."""
+
+    policy: str
+    model: ModelRef | None
+    config: EnvConfig
+    seed: int
+    policy_seed: int
+
+    def __str__(self) -> str:
+        return f"episode {self.seed} of {self.policy}"
+
+
+def play_evaluation_episode(task: EvaluationTask) -> EvaluationResult:
+    """The protocol on one episode (wherever it runs, the same result)."""
+    if task.model is not None:
+        policy = ModelPolicy(task.model.get().model, name=task.policy, deterministic=True)
+    else:
+        policy = make_policy(task.policy, task.policy_seed)
+    return evaluate({"config": task.config}, policy, episodes=1, seed=task.seed)
+
+
 def evaluate_model(
     loaded: LoadedModel,
     cfg: EnvConfig,
@@ -47,35 +76,44 @@ def evaluate_model(
     heuristics: Sequence[str] = ("greedy-distance",),
     name: str = "model",
     on_episode: Callable[[str, int], None] | None = None,
+    jobs: int | None = 1,
+    ray_address: str | None = None,
+    progress: bool = False,
 ) -> dict[str, Any]:
-    """The model and each heuristic on the same episodes (seeds ``seed .. seed+episodes-1``).
+    """The model and each heuristic on the same episodes (seeds ``seed .. seed+episodes-1``),
+    in ``jobs`` processes (``None``: every core) or on the Ray cluster at ``ray_address``
+    (:func:`~frontier_marl.utils.parallel.map_tasks`; the same result either way).
 
     Returns a JSON-able dict: ``model`` (the model's row with ``degeneracy``), ``heuristics``
     (one row per heuristic), ``rows`` (all rows, model first), the env config and the model
     file. Rows are :meth:`EvaluationResult.to_dict` outputs (per-episode curves included).
     """
     check_model_env(loaded, cfg)
-    env_kwargs = {"config": cfg}
-    policy = ModelPolicy(loaded.model, name=name, deterministic=True)
+    ref = ModelRef(source_of(loaded.path), loaded)
+    labels = [name, *heuristics]
+    tasks = [
+        EvaluationTask(label, ref if i == 0 else None, cfg, seed + k, seed)
+        for i, label in enumerate(labels)
+        for k in range(episodes)
+    ]
 
-    def progress(label: str) -> Callable[[int, Any], None] | None:
-        if on_episode is None:
-            return None
-        return lambda i, _record: on_episode(label, i)
+    def done(index: int, _result: EvaluationResult) -> None:
+        if on_episode is not None:
+            on_episode(tasks[index].policy, index % episodes)
 
-    model_row = evaluate(
-        dict(env_kwargs), policy, episodes=episodes, seed=seed, on_episode=progress(name)
-    ).to_dict()
-    model_row["degeneracy"] = degeneracy(model_row["action_shares"])
-    rows = [model_row]
-    for heuristic in heuristics:
-        row = evaluate(
-            dict(env_kwargs),
-            make_policy(heuristic, seed),
-            episodes=episodes,
-            seed=seed,
-            on_episode=progress(heuristic),
-        ).to_dict()
+    results = map_tasks(
+        play_evaluation_episode,
+        tasks,
+        jobs,
+        ray_address=ray_address,
+        progress=progress,
+        unit="ep",
+        on_done=done,
+    )
+    rows = []
+    for i in range(len(labels)):
+        part = results[i * episodes : (i + 1) * episodes]
+        row = replace(part[0], episodes=[r.episodes[0] for r in part]).to_dict()
         row["degeneracy"] = degeneracy(row["action_shares"])
         rows.append(row)
     meta = loaded.metadata or {}
@@ -86,7 +124,7 @@ def evaluate_model(
         "episodes": episodes,
         "seed": seed,
         "env_config": config_to_dict(cfg),
-        "model": model_row,
+        "model": rows[0],
         "heuristics": rows[1:],
         "rows": rows,
     }

@@ -18,9 +18,7 @@ Each round (``[regression]``, :class:`~frontier_marl.training.settings.Regressio
 from __future__ import annotations
 
 import json
-import multiprocessing as mp
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +43,7 @@ from frontier_marl.training.family_validation import FAILURE
 from frontier_marl.training.regression import fit, group
 from frontier_marl.training.results import TrainResult
 from frontier_marl.training.settings import RegressionSettings
+from frontier_marl.utils.parallel import map_tasks
 from frontier_marl.utils.progress import progress_bar as make_bar
 
 LOG_FILE = "validation.jsonl"
@@ -113,13 +112,14 @@ def train_cost_regression(
 def label_round(
     jobs: list[tuple[str, int]], state: dict[str, Any] | None, reg: RegressionSettings, seed: int
 ) -> Samples:
-    """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes."""
+    """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes
+    (:func:`~frontier_marl.utils.parallel.map_tasks`)."""
     tasks = [(name, ep, state, reg.scorer_width, reg.rule_share, seed) for name, ep in jobs]
-    if reg.label_workers == 1:
-        return Samples.join([_label(task) for task in tasks])
-    context = mp.get_context("spawn")  # torch in the workers: no fork of a threaded parent
-    with ProcessPoolExecutor(reg.label_workers, mp_context=context) as pool:
-        return Samples.join(list(pool.map(_label, tasks)))
+    return Samples.join(map_tasks(_label, tasks, reg.label_workers, label=_label_name))
+
+
+def _label_name(task: tuple[Any, ...]) -> str:
+    return f"the labels of episode {task[1]} of {task[0]}"
 
 
 def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Samples:

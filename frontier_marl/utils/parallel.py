@@ -39,6 +39,10 @@ RAY_HINT = 'Ray is not installed: pip install "frontier-marl[ray]"'
 ONE_THREAD = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
+#: Libraries a fork server imports once for all workers when this process has imported them.
+HEAVY = ("torch", "stable_baselines3", "sb3_contrib")
+
+
 class WorkerDied(RuntimeError):
     """A worker process ended without a result (killed, out of memory, crashed)."""
 
@@ -149,6 +153,14 @@ def start_method() -> str:
     return "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
 
 
+def _preload(fn: Callable) -> list[str]:
+    """What the fork server imports before it forks the workers: the package's modules this
+    process has imported, ``fn``'s module and the heavy optional libraries already in use."""
+    own = [name for name in sys.modules if name.startswith("frontier_marl.")]
+    heavy = [name for name in HEAVY if name in sys.modules]
+    return ["frontier_marl", *sorted(own), getattr(fn, "__module__", "frontier_marl"), *heavy]
+
+
 def _one_thread() -> None:
     """Worker initializer: numeric libraries on one thread each."""
     for name in ONE_THREAD:
@@ -174,7 +186,7 @@ def _in_processes(fn: Callable, tasks: list, jobs: int, label: Callable, done: _
     _check_picklable(fn, tasks, label)
     context = mp.get_context(start_method())
     if context.get_start_method() == "forkserver":
-        context.set_forkserver_preload(["frontier_marl", getattr(fn, "__module__", "")])
+        context.set_forkserver_preload(_preload(fn))
     pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread)
     try:
         with warnings.catch_warnings():  # Python 3.12+ warns of numpy's idle BLAS threads

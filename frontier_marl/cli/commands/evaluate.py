@@ -5,6 +5,7 @@ Examples::
     frontier-marl evaluate runs/config01/seed0                 # the run's final model.zip
     frontier-marl evaluate runs/config01/seed0/model.zip --map-mode dynamic --episodes 30 \\
         --json eval.json --plot actions.png
+    frontier-marl evaluate thesis-config01 --jobs 4          # 4 processes (default: all cores)
 
 The env is the one the model was trained on (read from the ``model.json`` beside it), changed
 only by ``--map-mode``, ``--preset`` and ``--set``. Reported: mean and std of the total episode
@@ -21,7 +22,9 @@ import sys
 from pathlib import Path
 
 from frontier_marl.cli.arguments import (
+    add_parallel_arguments,
     add_set_argument,
+    check_parallel_arguments,
     non_negative_int,
     parse_policies,
     positive_int,
@@ -34,7 +37,6 @@ from frontier_marl.evaluation.model_evaluation import (
 )
 from frontier_marl.policies.metadata import ModelEnvMismatchError
 from frontier_marl.policies.models import load_model
-from frontier_marl.utils.progress import progress_bar
 from frontier_marl.utils.set_options import parse_set_options
 
 
@@ -83,6 +85,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="comma-separated heuristics run on the same episodes "
         "(default: %(default)s; empty for none)",
     )
+    add_parallel_arguments(parser)
     parser.add_argument(
         "--json",
         type=Path,
@@ -115,6 +118,7 @@ def run(args: argparse.Namespace) -> int:
         heuristics = parse_policies(args.heuristics) if args.heuristics.strip() else []
         loaded = load_model(args.model)
         cfg = evaluation_env_config(loaded, args.preset, overrides)
+        check_parallel_arguments(args)
     except ValueError as exc:
         return _fail(str(exc))
     if loaded.metadata is None:
@@ -124,26 +128,20 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
 
-    total = args.episodes * (1 + len(heuristics))
-    with progress_bar(total, disable=args.no_progress, unit="ep") as bar:
-
-        def tick(label: str, _i: int) -> None:
-            bar.set_description(label)
-            bar.update(1)
-
-        try:
-            result = evaluate_model(
-                loaded,
-                cfg,
-                episodes=args.episodes,
-                seed=args.seed,
-                heuristics=heuristics,
-                name="model",
-                on_episode=tick,
-            )
-        except ModelEnvMismatchError as exc:
-            bar.close()
-            return _fail(str(exc))
+    try:
+        result = evaluate_model(
+            loaded,
+            cfg,
+            episodes=args.episodes,
+            seed=args.seed,
+            heuristics=heuristics,
+            name="model",
+            jobs=args.jobs,
+            ray_address=args.ray_address,
+            progress=not args.no_progress,
+        )
+    except (ModelEnvMismatchError, ConnectionError) as exc:
+        return _fail(str(exc))
     layout = f"map_seed={cfg.map_seed}" if cfg.map_mode == "static" else "fresh layout per seed"
     print(
         f"{loaded.path} ({result['num_timesteps']} training steps): {cfg.height}x{cfg.width}, "

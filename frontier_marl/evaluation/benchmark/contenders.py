@@ -2,10 +2,9 @@
 
 A contender built here is picklable: its factories are module-level functions, partials or
 small dataclasses that name what they load (a model's path, a scorer's folder), so an episode
-can be played in a worker process or on a Ray node (:mod:`frontier_marl.utils.parallel`). A
-process loads each model once (:func:`loaded_model`, :func:`loaded_scorer`; a file changed on
-disk is loaded again). A contender built from in-memory objects (a lambda over a live model)
-still runs in this process (``jobs=1``).
+can be played in a worker process or on a Ray node (:mod:`frontier_marl.utils.parallel`); each
+process loads a model once (:mod:`frontier_marl.evaluation.model_refs`). A contender built from
+in-memory objects (a lambda over a live model) runs in this process only (``jobs=1``).
 """
 
 from __future__ import annotations
@@ -19,22 +18,18 @@ from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
 from frontier_marl.evaluation.benchmark.families import OBSERVATION_KEYS, world_settings
+from frontier_marl.evaluation.model_refs import cached_model, cached_scorer, source_of
 from frontier_marl.policies.base import ModelPolicy
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.policies.models import (
-    MAP_SCORER_FILE,
     PRETRAINED,
     LoadedModel,
     check_model_env,
-    load_model,
     map_scorer_folder,
-    resolve_model_path,
 )
 from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
 
 ORACLE = "lookahead-oracle"
-_CACHE_SIZE = 8
-_LOADED: dict[tuple[str, str, int], Any] = {}
 
 
 @dataclass
@@ -57,39 +52,16 @@ def default_commit(agents: int) -> str:
     return "until-progress" if agents == 1 else "none"
 
 
-def _cached(kind: str, path: Path, load: Callable[[], Any]) -> Any:
-    """``load()``, once per process for ``path`` as it is now on disk."""
-    key = (kind, str(path), path.stat().st_mtime_ns)
-    if key not in _LOADED:
-        if len(_LOADED) >= _CACHE_SIZE:
-            del _LOADED[next(iter(_LOADED))]
-        _LOADED[key] = load()
-    return _LOADED[key]
-
-
 def loaded_model(source: str) -> LoadedModel:
     """The SB3 model ``source`` names (loaded once per process); ValueError if it cannot be
     loaded or has no metadata."""
     try:
-        loaded = _cached("sb3", resolve_model_path(source), partial(load_model, source))
+        loaded = cached_model(source)
     except Exception as exc:  # e.g. a file that is not an SB3 zip
         raise ValueError(f"cannot load model {source}: {exc}") from exc
     if loaded.metadata is None:
         raise ValueError(f"model {source}: no metadata saved beside it (its observation settings)")
     return loaded
-
-
-def loaded_scorer(folder: str) -> Any:
-    """The map scorer saved in ``folder`` (loaded once per process). Needs torch."""
-    try:  # torch is the train extra's
-        from frontier_marl.policies.map_explorer import load_scorer
-    except ModuleNotFoundError as exc:
-        raise ValueError(
-            f"model {folder}: a map scorer needs torch ({exc.name} is not installed): "
-            "pip install 'frontier-marl[train]'"
-        ) from None
-    path = Path(folder)
-    return _cached("scorer", path / MAP_SCORER_FILE, lambda: load_scorer(path)[0])
 
 
 def own_world(own: Mapping[str, Any], world: EnvConfig) -> EnvConfig:
@@ -137,7 +109,7 @@ class ScorerMaker:
     def __call__(self) -> Any:
         from frontier_marl.policies.map_explorer import MapExplorer  # torch: loaded_scorer's
 
-        return MapExplorer(loaded_scorer(self.folder), self.label)
+        return MapExplorer(cached_scorer(self.folder), self.label)
 
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
@@ -149,14 +121,9 @@ def heuristic(name: str, commit: str = "until-progress") -> Contender:
     return Contender(name, True, make, partial(own_world, env_settings(name)))
 
 
-def _source(name: str) -> str:
-    """A model's name as any process can find it: an existing path made absolute."""
-    return str(Path(name).resolve()) if Path(name).exists() else name
-
-
 def model(name: str) -> Contender:
     """A saved or shipped SB3 model (``thesis-config01``, a run folder, a model.zip)."""
-    source = _source(name)
+    source = source_of(name)
     loaded_model(source)  # fails here, not in an episode
     label = Path(name).stem if name.endswith(".zip") else Path(name).name
     return Contender(label, False, ModelMaker(source, label), ModelWorld(source))
@@ -166,7 +133,7 @@ def map_model(folder: Path, label: str) -> Contender:
     """A saved map-aware scorer (:mod:`frontier_marl.policies.map_explorer`): it chooses among
     frontier-rule's slots, in frontier-rule's env on each world. Needs torch."""
     source = str(Path(folder).resolve())
-    loaded_scorer(source)
+    cached_scorer(source)
     return Contender(label, False, ScorerMaker(source, label), heuristic("frontier-rule").config)
 
 
