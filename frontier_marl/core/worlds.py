@@ -88,7 +88,7 @@ class Worlds:
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
         self._structure = stacked_structure(params.connectivity)
-        self._fractions: dict[str, tuple[int, np.ndarray]] = {}
+        self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
 
     # ----------------------------------------------------------------- episodes
     def place(
@@ -164,9 +164,9 @@ class Worlds:
     # ----------------------------------------------------------------- frontier view
     def refresh_clusters(self) -> None:
         """Recluster the worlds whose belief changed since they were last clustered."""
-        stale = np.flatnonzero(self.clustered_version != self.version)
-        if len(stale) == 0:
+        if self.clustered_version.tobytes() == self.version.tobytes():  # the common case, fast
             return
+        stale = np.flatnonzero(self.clustered_version != self.version)
         masks = frontier_masks(self.belief, stale)
         labels, _ = ndimage.label(masks, structure=self._structure)
         cluster_worlds(
@@ -234,7 +234,7 @@ class Worlds:
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
         of the ``reachable`` free region known (kept until a belief changes; read-only)."""
-        key = int(self.version.sum())  # versions only grow: the sum moves with any of them
+        key = self.version.tobytes()  # the versions as they were when it was computed
         cached = self._fractions.get(basis)
         if cached is not None and cached[0] == key:
             return cached[1]

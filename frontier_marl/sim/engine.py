@@ -19,12 +19,14 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
+from frontier_marl.sim.decisions import decide
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.sim.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
 
 Observation = np.ndarray | dict[str, np.ndarray]
+_ONE = np.ones(1, dtype=bool)  # the active flags of a batch of one world
 
 
 @dataclass(slots=True)
@@ -97,18 +99,16 @@ class ExplorationMDP:
         n = cfg.n_agents
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
-        slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
-        targets = np.full((n, 2), -1, dtype=np.int64)
-        padding = np.zeros(n, dtype=bool)
+        slots = np.array(
+            [self._check_action(action, agent) for agent, action in enumerate(actions)],
+            dtype=np.int64,
+        )
         arrays = self._slot_arrays
         assert arrays is not None
-        for agent, slot in enumerate(slots):
-            live = arrays.live[agent]
-            if slot < live:  # live slots come first
-                targets[agent] = arrays.target[agent, slot]
-            else:
-                padding[agent] = live > 0
-        oscillation = self._oscillation.update(targets[None])[0]
+        chosen = decide(
+            arrays.live[None], arrays.target[None], slots[None], _ONE, self._oscillation.history
+        )
+        targets, padding, oscillation = chosen[0][0], chosen[1][0], chosen[2][0]
         world = self.world
         before = world.travelled.copy()
         if self._trail is not None:

@@ -48,6 +48,11 @@ class OscillationHistory:
         # the last window + 1 targets, oldest first
         self._history = np.full((n_worlds, n_agents, window + 1, 2), self._EMPTY, dtype=np.int64)
 
+    @property
+    def history(self) -> np.ndarray:
+        """The ``(W, N, window + 1, 2)`` targets, oldest first (changed in place)."""
+        return self._history
+
     def clear(self, worlds: np.ndarray | slice) -> None:
         """Forget the history of ``worlds`` (a new episode)."""
         self._history[worlds] = self._EMPTY
@@ -69,23 +74,29 @@ class OscillationHistory:
 @compiled
 def _oscillation_update(history: np.ndarray, targets: np.ndarray, out: np.ndarray) -> None:
     """:meth:`OscillationHistory.update` on its ``(W, N, window + 1, 2)`` history."""
-    depth = history.shape[2]
     for w in range(targets.shape[0]):
         for n in range(targets.shape[1]):
-            row, col = targets[w, n, 0], targets[w, n, 1]
-            last_row, last_col = history[w, n, depth - 1, 0], history[w, n, depth - 1, 1]
-            flag = False
-            if row >= 0 and last_row >= 0 and (row != last_row or col != last_col):
-                for i in range(depth - 1):
-                    if history[w, n, i, 0] == row and history[w, n, i, 1] == col:
-                        flag = True
-                        break
-            out[w, n] = flag
-            for i in range(depth - 1):
-                history[w, n, i, 0] = history[w, n, i + 1, 0]
-                history[w, n, i, 1] = history[w, n, i + 1, 1]
-            history[w, n, depth - 1, 0] = row
-            history[w, n, depth - 1, 1] = col
+            out[w, n] = oscillation_step(history[w, n], targets[w, n, 0], targets[w, n, 1])
+
+
+@compiled
+def oscillation_step(history: np.ndarray, row: int, col: int) -> bool:
+    """One robot's oscillation test on its ``(window + 1, 2)`` history, which then records
+    the target (row, col)."""
+    depth = history.shape[0]
+    last_row, last_col = history[depth - 1, 0], history[depth - 1, 1]
+    flag = False
+    if row >= 0 and last_row >= 0 and (row != last_row or col != last_col):
+        for i in range(depth - 1):
+            if history[i, 0] == row and history[i, 1] == col:
+                flag = True
+                break
+    for i in range(depth - 1):
+        history[i, 0] = history[i + 1, 0]
+        history[i, 1] = history[i + 1, 1]
+    history[depth - 1, 0] = row
+    history[depth - 1, 1] = col
+    return flag
 
 
 class OscillationDetector:

@@ -249,8 +249,12 @@ class RegressionSettings:
 
     def __post_init__(self) -> None:
         weights = self.rule_weights
-        if not isinstance(weights, tuple | list) or not weights or not all(
-            isinstance(w, int | float) and not isinstance(w, bool) and w >= 0 for w in weights
+        if (
+            not isinstance(weights, tuple | list)
+            or not weights
+            or not all(
+                isinstance(w, int | float) and not isinstance(w, bool) and w >= 0 for w in weights
+            )
         ):
             raise ValueError(
                 f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
