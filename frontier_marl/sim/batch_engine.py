@@ -17,7 +17,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.sim.decisions import decide
+from frontier_marl.sim.decisions import decide, heading_of
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
@@ -130,10 +130,9 @@ class BatchMDP:
         outcome.truncated &= active
         outcome.reason[~active] = 0
         self.done |= outcome.terminated | outcome.truncated
-        going = (targets[..., 0] >= 0) & ~worlds.reached
         # inactive worlds keep their targets, heading and flags
         moved = active[:, None]
-        heading = np.where(going[..., None], targets, -1)
+        heading = heading_of(targets, worlds.reached)
         self.heading = np.where(moved[..., None], heading, self.heading)
         self.targets = np.where(moved[..., None], targets, self.targets)
         self.padding = np.where(moved, padding, self.padding)

@@ -39,3 +39,16 @@ def decide(
                 padding[w, n] = live[w, n] > 0
             oscillation[w, n] = oscillation_step(history[w, n], targets[w, n, 0], targets[w, n, 1])
     return targets, padding, oscillation
+
+
+@compiled
+def heading_of(targets: np.ndarray, reached: np.ndarray) -> np.ndarray:
+    """(W, N, 2) the cells the robots head to after a step: their ``targets`` (W, N, 2) where
+    they have one and have not ``reached`` it (W, N), row -1 elsewhere."""
+    heading = np.full(targets.shape, -1, dtype=np.int64)
+    for w in range(targets.shape[0]):
+        for n in range(targets.shape[1]):
+            if targets[w, n, 0] >= 0 and not reached[w, n]:
+                heading[w, n, 0] = targets[w, n, 0]
+                heading[w, n, 1] = targets[w, n, 1]
+    return heading

@@ -19,7 +19,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
-from frontier_marl.sim.decisions import decide
+from frontier_marl.sim.decisions import decide, heading_of
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
@@ -110,13 +110,14 @@ class ExplorationMDP:
         )
         targets, padding, oscillation = chosen[0][0], chosen[1][0], chosen[2][0]
         world = self.world
-        before = world.travelled.copy()
+        before = world.travelled.copy() if cfg.reward.kind == "travel" else None
         if self._trail is not None:
-            self._trail.push(world.positions[None], np.ones(1, dtype=bool))
+            self._trail.push(world.positions[None], _ONE)
         moved = world.move(targets)
         self.steps += 1
         new_cells = moved.new_cells
-        self.steps_without_progress = 0 if new_cells.any() else self.steps_without_progress + 1
+        progress = np.count_nonzero(new_cells) > 0  # faster than any() on a few cells
+        self.steps_without_progress = 0 if progress else self.steps_without_progress + 1
         self._refresh_slots()
         assert self._slot_arrays is not None
         if cfg.observation.commit != "none":
@@ -137,10 +138,10 @@ class ExplorationMDP:
                 padding[None],
                 oscillation[None],
                 np.array([fraction >= cfg.reward.explore_threshold]),
-                np.array([not self._slot_arrays.live.any()]),
+                np.array([np.count_nonzero(self._slot_arrays.live) == 0]),
                 np.array([self.steps]),
                 np.array([self.steps_without_progress]),
-                (world.travelled - before)[None],
+                None if before is None else (world.travelled - before)[None],
             )
         )
         self.done = outcome.terminated or outcome.truncated
@@ -185,7 +186,8 @@ class ExplorationMDP:
         self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
-        """The slot tables the robots observe now (the ones their next actions refer to)."""
+        """The slot tables the robots observe now (the ones their next actions refer to):
+        views of buffers that the next step overwrites."""
         if self._tables is None:
             arrays = self._slot_arrays
             assert arrays is not None
@@ -193,14 +195,15 @@ class ExplorationMDP:
         return list(self._tables)
 
     def slot_arrays(self) -> SlotArrays:
-        """The robots' slots as ``(N, ...)`` arrays (those of :meth:`slot_tables`)."""
+        """The robots' slots as ``(N, ...)`` arrays (those of :meth:`slot_tables`; views of
+        buffers that the next step overwrites)."""
         assert self._slot_arrays is not None
         return self._slot_arrays
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None
-        return list(self._slot_arrays.mask)
+        return list(self._slot_arrays.mask.copy())
 
     def _observations(
         self, targets: np.ndarray | None, reached: np.ndarray | None
@@ -237,8 +240,7 @@ class ExplorationMDP:
         (row -1: none, as before the first decision)."""
         if targets is None or reached is None:
             return np.full((self.cfg.n_agents, 2), -1, dtype=np.int64)
-        going = (targets[:, 0] >= 0) & ~reached
-        return np.where(going[:, None], targets, -1)
+        return heading_of(targets[None], reached[None])[0]
 
     def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:

@@ -26,7 +26,6 @@ penalty. The episode also terminates when no robot has a reachable frontier left
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -181,6 +180,7 @@ def batch_outcome(
     travel = cfg.kind == "travel"
     if travel and moved is None:
         raise ValueError("the travel reward needs the cells each robot walked")
+    new_cells = np.asarray(new_cells, dtype=np.int64)
     worlds, robots = new_cells.shape
     outcome = BatchOutcome(
         np.empty((worlds, robots)),
@@ -194,14 +194,14 @@ def batch_outcome(
         cfg.padding_truncates,
         cfg.no_progress_limit,
         cfg.max_steps,
-        np.asarray(new_cells, dtype=np.int64),
+        new_cells,
         np.asarray(padding, dtype=np.bool_),
         np.asarray(oscillation, dtype=np.bool_),
         np.asarray(threshold_reached, dtype=np.bool_),
         np.asarray(no_frontier_left, dtype=np.bool_),
         np.asarray(steps_taken, dtype=np.int64),
         np.asarray(steps_without_progress, dtype=np.int64),
-        np.zeros_like(new_cells, dtype=np.int64) if moved is None else moved.astype(np.int64),
+        new_cells if moved is None else np.asarray(moved, dtype=np.int64),  # read by travel only
         outcome.rewards,
         outcome.terminated,
         outcome.truncated,
@@ -210,9 +210,23 @@ def batch_outcome(
     return outcome
 
 
-@functools.lru_cache(maxsize=64)
+#: The reward table's constants by config, found by identity (hashing a config costs more
+#: than the table): ``id(cfg) -> (cfg, constants)``, the config kept so its id stays its own.
+_CONSTANTS: dict[int, tuple[RewardConfig, np.ndarray]] = {}
+
+
 def _constants(cfg: RewardConfig) -> np.ndarray:
     """The reward table's constants, in :func:`_reward_table`'s order."""
+    cached = _CONSTANTS.get(id(cfg))
+    if cached is not None and cached[0] is cfg:
+        return cached[1]
+    if len(_CONSTANTS) >= 64:
+        _CONSTANTS.clear()
+    _CONSTANTS[id(cfg)] = (cfg, _table_constants(cfg))
+    return _CONSTANTS[id(cfg)][1]
+
+
+def _table_constants(cfg: RewardConfig) -> np.ndarray:
     travel = cfg.kind == "travel"
     constants = np.array(
         [
