@@ -152,7 +152,7 @@ class FrontierParallelEnv(ParallelEnv):
         agents = self.agents
         result = self._mdp.step([actions[agent] for agent in agents])
         observations = dict(zip(agents, map(self.layout.wrap, result.observations), strict=True))
-        rewards = {agent: float(r) for agent, r in zip(agents, result.rewards, strict=True)}
+        rewards = dict(zip(agents, result.rewards.tolist(), strict=True))
         terminations = dict.fromkeys(agents, result.terminated)
         truncations = dict.fromkeys(agents, result.truncated)
         infos = dict(zip(agents, build_infos(self._mdp, result, self._info_level), strict=True))

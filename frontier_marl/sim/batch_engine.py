@@ -90,7 +90,10 @@ class BatchMDP:
         slots = self.slots
         history = self._oscillation.history
         chosen = np.asarray(actions, dtype=np.int64)
-        targets, padding, oscillation = decide(slots.live, slots.target, chosen, active, history)
+        targets = np.empty((self.n_worlds, self.n_agents, 2), dtype=np.int64)
+        padding = np.empty((self.n_worlds, self.n_agents), dtype=bool)
+        oscillation = np.empty_like(padding)
+        decide(slots.live, slots.target, chosen, active, history, targets, padding, oscillation)
         worlds = self.worlds
         before = worlds.travelled.copy()
         if self._trail is not None:
@@ -132,7 +135,8 @@ class BatchMDP:
         self.done |= outcome.terminated | outcome.truncated
         # inactive worlds keep their targets, heading and flags
         moved = active[:, None]
-        heading = heading_of(targets, worlds.reached)
+        heading = np.empty_like(targets)
+        heading_of(targets, worlds.reached, heading)
         self.heading = np.where(moved[..., None], heading, self.heading)
         self.targets = np.where(moved[..., None], targets, self.targets)
         self.padding = np.where(moved, padding, self.padding)
