@@ -82,6 +82,7 @@ class ExplorationMDP:
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
         self.steps = 0
         self.steps_without_progress = 0
+        self.explored = 0.0  # the explored fraction on the threshold's basis, now
         self.done = True
 
     # ------------------------------------------------------------------ episode
@@ -94,6 +95,7 @@ class ExplorationMDP:
             self._trail.clear(slice(None), self.world.positions[None])
         self.steps = 0
         self.steps_without_progress = 0
+        self.explored = self.world.explored_fraction(self.cfg.reward.threshold_basis)
         self.done = False
         self.last = None
         self._refresh_slots()
@@ -180,7 +182,7 @@ class ExplorationMDP:
         """The reward table on this step (one world's scalars in persistent arrays)."""
         assert self.world is not None and self._slot_arrays is not None
         reward = self.cfg.reward
-        fraction = self.world.explored_fraction(reward.threshold_basis)
+        fraction = self.explored = self.world.explored_fraction(reward.threshold_basis)
         self._threshold[0] = fraction >= reward.explore_threshold
         self._no_frontier[0] = np.count_nonzero(self._slot_arrays.live) == 0
         self._steps[0], self._stalled[0] = self.steps, self.steps_without_progress
