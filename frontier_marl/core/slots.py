@@ -156,17 +156,19 @@ class SlotArrays:
     def packed(self) -> np.ndarray:
         """The fields as one float64 array ``(..., n_slots, 10)`` in :data:`SLOT_COLUMNS`'s
         order (the mask is left out: it is the action mask)."""
-        columns = (
-            self.cluster[..., None],
-            self.valid[..., None],
+        out = np.empty((*self.cluster.shape, len(SLOT_COLUMNS)))
+        _pack(
+            self.cluster,
+            self.valid,
             self.centroid,
             self.target,
-            self.distance[..., None],
-            self.path_length[..., None],
-            self.size[..., None],
-            self.gain[..., None],
+            self.distance,
+            self.path_length,
+            self.size,
+            self.gain,
+            out,
         )
-        return np.concatenate(columns, axis=-1, dtype=np.float64)
+        return out
 
     def table(self, row: int) -> SlotTable:
         """Robot ``row``'s :class:`SlotTable` (views) of ``(M, ...)`` arrays."""
@@ -202,6 +204,35 @@ class SlotArrays:
             mask=np.empty(shape, dtype=np.int8),
             live=np.empty(shape[:2], dtype=np.int64),
         )
+
+
+@compiled
+def _pack(
+    cluster: np.ndarray,
+    valid: np.ndarray,
+    centroid: np.ndarray,
+    target: np.ndarray,
+    distance: np.ndarray,
+    path_length: np.ndarray,
+    size: np.ndarray,
+    gain: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """:meth:`SlotArrays.packed` into ``out`` (a C-contiguous ``(..., n_slots, 10)`` array)."""
+    rows = out.reshape(-1, out.shape[-1])
+    c, v, d, p = cluster.ravel(), valid.ravel(), distance.ravel(), path_length.ravel()
+    xy, cell, s, g = centroid.ravel(), target.ravel(), size.ravel(), gain.ravel()
+    for i in range(rows.shape[0]):
+        rows[i, 0] = c[i]
+        rows[i, 1] = v[i]
+        rows[i, 2] = xy[2 * i]
+        rows[i, 3] = xy[2 * i + 1]
+        rows[i, 4] = cell[2 * i]
+        rows[i, 5] = cell[2 * i + 1]
+        rows[i, 6] = d[i]
+        rows[i, 7] = p[i]
+        rows[i, 8] = s[i]
+        rows[i, 9] = g[i]
 
 
 def commit_to_previous(

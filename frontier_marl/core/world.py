@@ -69,6 +69,9 @@ class World:
         self.params = worlds.params
         self._active = np.zeros(worlds.n_worlds, dtype=bool)
         self._active[index] = True
+        self._index_array = np.array([index])
+        self._slots: SlotArrays | None = None  # the buffers of slot_arrays, made on first use
+        self._slot_view: SlotArrays | None = None
         self._make_views()
 
     def _make_views(self) -> None:
@@ -153,10 +156,13 @@ class World:
         return self._worlds.gains[self._index, : self._worlds.n_clusters[self._index]]
 
     def slot_arrays(self, n_slots: int, sort_by_distance: bool) -> SlotArrays:
-        """The slots of every robot, ``(K, n_slots, ...)`` arrays from one compiled call."""
-        out = SlotArrays.empty(self._worlds.n_worlds, self.n_agents, n_slots)
-        self._worlds.slots(out, np.array([self._index]), sort_by_distance)
-        return out.world(self._index)
+        """The slots of every robot, ``(K, n_slots, ...)`` arrays from one compiled call, in
+        buffers of this view that the next call overwrites (copy what must outlive it)."""
+        if self._slots is None or self._slots.cluster.shape[-1] != n_slots:
+            self._slots = SlotArrays.empty(self._worlds.n_worlds, self.n_agents, n_slots)
+            self._slot_view = self._slots.world(self._index)
+        self._worlds.slots(self._slots, self._index_array, sort_by_distance)
+        return self._slot_view
 
     def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""

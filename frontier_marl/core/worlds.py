@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from frontier_marl.core.compiled import compiled
 from frontier_marl.core.frontiers import (
     Clusters,
     cluster_worlds,
@@ -28,9 +27,9 @@ from frontier_marl.core.frontiers import (
 )
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
-from frontier_marl.core.movement import walk
 from frontier_marl.core.sensing import Sensor, reveal
-from frontier_marl.core.slots import SlotArrays, _robot_slots
+from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.world_kernels import all_slots, count_known, settle_clusters, walk_worlds
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
 
@@ -88,7 +87,7 @@ class Worlds:
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
         self._structure = stacked_structure(params.connectivity)
-        self._fractions: dict[str, tuple[int, np.ndarray]] = {}
+        self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
 
     # ----------------------------------------------------------------- episodes
     def place(
@@ -164,9 +163,9 @@ class Worlds:
     # ----------------------------------------------------------------- frontier view
     def refresh_clusters(self) -> None:
         """Recluster the worlds whose belief changed since they were last clustered."""
-        stale = np.flatnonzero(self.clustered_version != self.version)
-        if len(stale) == 0:
+        if self.clustered_version.tobytes() == self.version.tobytes():  # the common case, fast
             return
+        stale = np.flatnonzero(self.clustered_version != self.version)
         masks = frontier_masks(self.belief, stale)
         labels, _ = ndimage.label(masks, structure=self._structure)
         cluster_worlds(
@@ -181,13 +180,20 @@ class Worlds:
             self.centroids,
             self.n_clusters,
         )
-        if self.params.gain == "unknown":
+        by_size = self.params.gain != "unknown"
+        if not by_size:
             for world in stale.tolist():
                 count = int(self.n_clusters[world])
                 self.gains[world, :count] = unknown_around(self.belief[world], self.clusters(world))
-        else:
-            self.gains[stale] = self.sizes[stale]
-        self.clustered_version[stale] = self.version[stale]
+        settle_clusters(
+            stale,
+            by_size,
+            self.sizes,
+            self.n_clusters,
+            self.version,
+            self.gains,
+            self.clustered_version,
+        )
 
     def clusters(self, world: int) -> Clusters:
         """World ``world``'s clusters as of its last :meth:`refresh_clusters`."""
@@ -234,7 +240,7 @@ class Worlds:
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
         of the ``reachable`` free region known (kept until a belief changes; read-only)."""
-        key = int(self.version.sum())  # versions only grow: the sum moves with any of them
+        key = self.version.tobytes()  # the versions as they were when it was computed
         cached = self._fractions.get(basis)
         if cached is not None and cached[0] == key:
             return cached[1]
@@ -260,117 +266,3 @@ def reachable_region(true_grid: np.ndarray, starts: np.ndarray) -> np.ndarray:
     labels, _ = ndimage.label(~true_grid, structure=FOUR_CONNECTED)
     ids = np.unique(labels[starts[:, 0], starts[:, 1]])
     return np.isin(labels, ids)
-
-
-@compiled
-def walk_worlds(
-    active: np.ndarray,
-    true: np.ndarray,
-    belief: np.ndarray,
-    seen: np.ndarray,
-    positions: np.ndarray,
-    travelled: np.ndarray,
-    goals: np.ndarray,
-    plan_cells: np.ndarray,
-    plan_meta: np.ndarray,
-    version: np.ndarray,
-    cells_per_step: int,
-    offsets: np.ndarray,
-    between: np.ndarray,
-    new_cells: np.ndarray,
-    walked: np.ndarray,
-    walked_len: np.ndarray,
-    reached: np.ndarray,
-) -> None:
-    """:func:`~frontier_marl.core.movement.walk` for every active world."""
-    for n in range(len(active)):
-        if not active[n]:
-            continue
-        version[n] = walk(
-            true[n],
-            belief[n],
-            seen[n],
-            positions[n],
-            travelled[n],
-            goals[n],
-            plan_cells[n],
-            plan_meta[n],
-            version[n],
-            cells_per_step,
-            offsets,
-            between,
-            new_cells[n],
-            walked[n],
-            walked_len[n],
-            reached[n],
-        )
-
-
-@compiled
-def all_slots(
-    worlds: np.ndarray,
-    belief: np.ndarray,
-    positions: np.ndarray,
-    cell_rows: np.ndarray,
-    cell_cols: np.ndarray,
-    cell_cluster: np.ndarray,
-    n_cells: np.ndarray,
-    centroids: np.ndarray,
-    sizes: np.ndarray,
-    gains: np.ndarray,
-    n_clusters: np.ndarray,
-    n_slots: int,
-    sort: bool,
-    cluster: np.ndarray,
-    valid: np.ndarray,
-    centroid: np.ndarray,
-    target: np.ndarray,
-    distance: np.ndarray,
-    size: np.ndarray,
-    gain: np.ndarray,
-    path_length: np.ndarray,
-    mask: np.ndarray,
-    live: np.ndarray,
-) -> None:
-    """:func:`~frontier_marl.core.slots._robot_slots` of every robot of ``worlds``, into the
-    outputs."""
-    for n in worlds:
-        cells, count = n_cells[n], n_clusters[n]
-        for k in range(positions.shape[1]):
-            result = _robot_slots(
-                belief[n],
-                positions[n, k, 0],
-                positions[n, k, 1],
-                cell_rows[n, :cells],
-                cell_cols[n, :cells],
-                cell_cluster[n, :cells],
-                centroids[n, :count],
-                sizes[n, :count],
-                gains[n, :count],
-                n_slots,
-                sort,
-            )
-            cluster[n, k] = result[0]
-            valid[n, k] = result[1]
-            centroid[n, k] = result[2]
-            target[n, k] = result[3]
-            distance[n, k] = result[4]
-            size[n, k] = result[5]
-            gain[n, k] = result[6]
-            path_length[n, k] = result[7]
-            mask[n, k] = result[8]
-            live[n, k] = result[9]
-
-
-@compiled
-def count_known(belief: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Per world, the known cells of ``belief`` inside the bool mask ``region``."""
-    out = np.zeros(belief.shape[0], dtype=np.int64)
-    for n in range(belief.shape[0]):
-        count = 0
-        for r in range(belief.shape[1]):
-            for c in range(belief.shape[2]):
-                if region[n, r, c] and belief[n, r, c] != UNKNOWN:
-                    count += 1
-        out[n] = count
-    return out

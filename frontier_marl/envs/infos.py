@@ -87,8 +87,9 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
     n = len(masks)
     if level == "mask":
         return [StepInfo(action_mask=mask) for mask in masks]
-    fraction = world.explored_fraction(mdp.cfg.reward.threshold_basis)
-    coverage = world.explored_fraction("reachable")
+    fraction = mdp.explored
+    reachable = mdp.cfg.reward.threshold_basis == "reachable"
+    coverage = fraction if reachable else world.explored_fraction("reachable")
     travelled = world.travelled.tolist()
     new_cells = [0] * n if result is None else result.move.new_cells.tolist()
     reason = 0 if result is None else result.outcome.code
@@ -105,7 +106,7 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
     ]
     if level == "minimal":
         return infos
-    positions = world.positions.astype(np.int64)  # a fresh array
+    positions = world.positions.copy()
     if result is None:
         targets = np.full((n, 2), -1, dtype=np.int64)
         padding = oscillation = [False] * n

@@ -97,6 +97,8 @@ class FrontierParallelEnv(ParallelEnv):
         self.action_spaces = dict.fromkeys(self.possible_agents, self._act_space)
         self.state_space = spaces.Box(-1, 1, self.config.shape, dtype=np.int8)
         self._rng: np.random.Generator | None = None
+        self._agents_seen: list[str] | None = None  # the agents list _agents_frozen holds
+        self._agents_frozen: frozenset[str] = frozenset()
 
     def observation_space(self, agent: str) -> spaces.Space[Any]:
         return self._obs_space
@@ -142,17 +144,17 @@ class FrontierParallelEnv(ParallelEnv):
     ]:
         if not self.agents:
             raise RuntimeError("step() called with no live agents: call reset() first")
-        missing = [agent for agent in self.agents if agent not in actions]
-        extra = [agent for agent in actions if agent not in self.agents]
-        if missing or extra:
+        agents = self.agents
+        if actions.keys() != self._agent_set(agents):
+            missing = [agent for agent in agents if agent not in actions]
+            extra = [agent for agent in actions if agent not in agents]
             raise ValueError(
-                f"actions must have one entry per live agent {self.agents}; "
+                f"actions must have one entry per live agent {agents}; "
                 f"missing {missing}, unexpected {extra}"
             )
-        agents = self.agents
         result = self._mdp.step([actions[agent] for agent in agents])
         observations = dict(zip(agents, map(self.layout.wrap, result.observations), strict=True))
-        rewards = {agent: float(r) for agent, r in zip(agents, result.rewards, strict=True)}
+        rewards = dict(zip(agents, result.rewards.tolist(), strict=True))
         terminations = dict.fromkeys(agents, result.terminated)
         truncations = dict.fromkeys(agents, result.truncated)
         infos = dict(zip(agents, build_infos(self._mdp, result, self._info_level), strict=True))
@@ -161,6 +163,12 @@ class FrontierParallelEnv(ParallelEnv):
         if self.render_mode == "human":
             self.render()
         return observations, rewards, terminations, truncations, infos
+
+    def _agent_set(self, agents: list[str]) -> frozenset[str]:
+        """The names in ``agents`` as a set, kept while the list is the same object."""
+        if self._agents_seen is not agents:
+            self._agents_seen, self._agents_frozen = agents, frozenset(agents)
+        return self._agents_frozen
 
     def render(self) -> Any:
         return self._renderer.render(self._mdp)

@@ -17,6 +17,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
+from frontier_marl.sim.decisions import decide, heading_of
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
@@ -87,13 +88,12 @@ class BatchMDP:
         while others play forced steps) keep their state: they do not move and get no reward
         or end flag."""
         slots = self.slots
-        live = slots.live
-        chosen = actions < live  # live slots come first
-        picked = np.take_along_axis(slots.target, actions[:, :, None, None], axis=2)[:, :, 0]
-        targets = np.where(chosen[..., None], picked, -1)
-        targets[~active] = -1
-        padding = ~chosen & (live > 0) & active[:, None]
-        oscillation = self._oscillation.update(targets, active)
+        history = self._oscillation.history
+        chosen = np.asarray(actions, dtype=np.int64)
+        targets = np.empty((self.n_worlds, self.n_agents, 2), dtype=np.int64)
+        padding = np.empty((self.n_worlds, self.n_agents), dtype=bool)
+        oscillation = np.empty_like(padding)
+        decide(slots.live, slots.target, chosen, active, history, targets, padding, oscillation)
         worlds = self.worlds
         before = worlds.travelled.copy()
         if self._trail is not None:
@@ -133,10 +133,10 @@ class BatchMDP:
         outcome.truncated &= active
         outcome.reason[~active] = 0
         self.done |= outcome.terminated | outcome.truncated
-        going = (targets[..., 0] >= 0) & ~worlds.reached
         # inactive worlds keep their targets, heading and flags
         moved = active[:, None]
-        heading = np.where(going[..., None], targets, -1)
+        heading = np.empty_like(targets)
+        heading_of(targets, worlds.reached, heading)
         self.heading = np.where(moved[..., None], heading, self.heading)
         self.targets = np.where(moved[..., None], targets, self.targets)
         self.padding = np.where(moved, padding, self.padding)

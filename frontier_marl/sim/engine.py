@@ -19,12 +19,19 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SlotArrays, SlotTable, commit_to_previous
 from frontier_marl.core.world import MoveResult, World
+from frontier_marl.sim.decisions import decide, heading_of
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
-from frontier_marl.sim.rewards import OscillationHistory, StepOutcome, batch_outcome, first_outcome
+from frontier_marl.sim.rewards import (
+    OscillationHistory,
+    StepOutcome,
+    batch_outcome,
+    first_outcome,
+)
 
 Observation = np.ndarray | dict[str, np.ndarray]
+_ONE = np.ones(1, dtype=bool)  # the active flags of a batch of one world
 
 
 @dataclass(slots=True)
@@ -70,8 +77,12 @@ class ExplorationMDP:
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
         self.last: StepResult | None = None  # the latest step, None right after reset
+        # The reward table's per-world inputs, (1,) arrays refilled every step.
+        self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
+        self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
         self.steps = 0
         self.steps_without_progress = 0
+        self.explored = 0.0  # the explored fraction on the threshold's basis, now
         self.done = True
 
     # ------------------------------------------------------------------ episode
@@ -84,6 +95,7 @@ class ExplorationMDP:
             self._trail.clear(slice(None), self.world.positions[None])
         self.steps = 0
         self.steps_without_progress = 0
+        self.explored = self.world.explored_fraction(self.cfg.reward.threshold_basis)
         self.done = False
         self.last = None
         self._refresh_slots()
@@ -97,52 +109,25 @@ class ExplorationMDP:
         n = cfg.n_agents
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
-        slots = [self._check_action(action, agent) for agent, action in enumerate(actions)]
-        targets = np.full((n, 2), -1, dtype=np.int64)
-        padding = np.zeros(n, dtype=bool)
-        arrays = self._slot_arrays
-        assert arrays is not None
-        for agent, slot in enumerate(slots):
-            live = arrays.live[agent]
-            if slot < live:  # live slots come first
-                targets[agent] = arrays.target[agent, slot]
-            else:
-                padding[agent] = live > 0
-        oscillation = self._oscillation.update(targets[None])[0]
+        slots = np.array(
+            [self._check_action(action, agent) for agent, action in enumerate(actions)],
+            dtype=np.int64,
+        )
+        targets, padding, oscillation = self._decide(slots)
         world = self.world
-        before = world.travelled.copy()
+        before = world.travelled.copy() if cfg.reward.kind == "travel" else None
         if self._trail is not None:
-            self._trail.push(world.positions[None], np.ones(1, dtype=bool))
+            self._trail.push(world.positions[None], _ONE)
         moved = world.move(targets)
         self.steps += 1
         new_cells = moved.new_cells
-        self.steps_without_progress = 0 if new_cells.any() else self.steps_without_progress + 1
+        progress = np.count_nonzero(new_cells) > 0  # faster than any() on a few cells
+        self.steps_without_progress = 0 if progress else self.steps_without_progress + 1
         self._refresh_slots()
-        assert self._slot_arrays is not None
         if cfg.observation.commit != "none":
-            arrays = self._slot_arrays
-            arrays.mask[:] = commit_to_previous(
-                arrays.mask,
-                arrays.target,
-                arrays.valid,
-                targets,
-                new_cells > 0,
-                cfg.observation.commit,
-            )
-        fraction = world.explored_fraction(cfg.reward.threshold_basis)
-        outcome = first_outcome(
-            batch_outcome(
-                cfg.reward,
-                new_cells[None],
-                padding[None],
-                oscillation[None],
-                np.array([fraction >= cfg.reward.explore_threshold]),
-                np.array([not self._slot_arrays.live.any()]),
-                np.array([self.steps]),
-                np.array([self.steps_without_progress]),
-                (world.travelled - before)[None],
-            )
-        )
+            self._commit(targets, new_cells)
+        travel = None if before is None else world.travelled - before
+        outcome = self._outcome(new_cells, padding, oscillation, travel)
         self.done = outcome.terminated or outcome.truncated
         self.last = StepResult(
             self._observations(targets, moved.reached),
@@ -155,6 +140,65 @@ class ExplorationMDP:
         return self.last
 
     # ------------------------------------------------------------------ helpers
+    def _decide(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Targets (N, 2), padding and oscillation flags (N,) of the chosen ``slots``."""
+        arrays = self._slot_arrays
+        assert arrays is not None
+        n = len(slots)
+        targets = np.empty((n, 2), dtype=np.int64)
+        padding, oscillation = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+        decide(
+            arrays.live[None],
+            arrays.target[None],
+            slots[None],
+            _ONE,
+            self._oscillation.history,
+            targets[None],
+            padding[None],
+            oscillation[None],
+        )
+        return targets, padding, oscillation
+
+    def _commit(self, targets: np.ndarray, new_cells: np.ndarray) -> None:
+        """Narrow the action masks to the previous targets (the ``commit`` rule)."""
+        arrays = self._slot_arrays
+        assert arrays is not None
+        arrays.mask[:] = commit_to_previous(
+            arrays.mask,
+            arrays.target,
+            arrays.valid,
+            targets,
+            new_cells > 0,
+            self.cfg.observation.commit,
+        )
+
+    def _outcome(
+        self,
+        new_cells: np.ndarray,
+        padding: np.ndarray,
+        oscillation: np.ndarray,
+        travel: np.ndarray | None,
+    ) -> StepOutcome:
+        """The reward table on this step (one world's scalars in persistent arrays)."""
+        assert self.world is not None and self._slot_arrays is not None
+        reward = self.cfg.reward
+        fraction = self.explored = self.world.explored_fraction(reward.threshold_basis)
+        self._threshold[0] = fraction >= reward.explore_threshold
+        self._no_frontier[0] = np.count_nonzero(self._slot_arrays.live) == 0
+        self._steps[0], self._stalled[0] = self.steps, self.steps_without_progress
+        outcome = batch_outcome(
+            reward,
+            new_cells[None],
+            padding[None],
+            oscillation[None],
+            self._threshold,
+            self._no_frontier,
+            self._steps,
+            self._stalled,
+            None if travel is None else travel[None],
+        )
+        return first_outcome(outcome)
+
     def _check_action(self, action: Any, agent: int) -> int:
         if type(action) is int and 0 <= action < self.cfg.n_slots:  # the common case, fast
             return action
@@ -185,7 +229,8 @@ class ExplorationMDP:
         self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
-        """The slot tables the robots observe now (the ones their next actions refer to)."""
+        """The slot tables the robots observe now (the ones their next actions refer to):
+        views of buffers that the next step overwrites."""
         if self._tables is None:
             arrays = self._slot_arrays
             assert arrays is not None
@@ -193,14 +238,15 @@ class ExplorationMDP:
         return list(self._tables)
 
     def slot_arrays(self) -> SlotArrays:
-        """The robots' slots as ``(N, ...)`` arrays (those of :meth:`slot_tables`)."""
+        """The robots' slots as ``(N, ...)`` arrays (those of :meth:`slot_tables`; views of
+        buffers that the next step overwrites)."""
         assert self._slot_arrays is not None
         return self._slot_arrays
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None
-        return list(self._slot_arrays.mask)
+        return list(self._slot_arrays.mask.copy())
 
     def _observations(
         self, targets: np.ndarray | None, reached: np.ndarray | None
@@ -237,8 +283,9 @@ class ExplorationMDP:
         (row -1: none, as before the first decision)."""
         if targets is None or reached is None:
             return np.full((self.cfg.n_agents, 2), -1, dtype=np.int64)
-        going = (targets[:, 0] >= 0) & ~reached
-        return np.where(going[:, None], targets, -1)
+        heading = np.empty_like(targets)
+        heading_of(targets[None], reached[None], heading[None])
+        return heading
 
     def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:

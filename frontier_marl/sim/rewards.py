@@ -26,7 +26,6 @@ penalty. The episode also terminates when no robot has a reachable frontier left
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -47,6 +46,11 @@ class OscillationHistory:
         self.window = window
         # the last window + 1 targets, oldest first
         self._history = np.full((n_worlds, n_agents, window + 1, 2), self._EMPTY, dtype=np.int64)
+
+    @property
+    def history(self) -> np.ndarray:
+        """The ``(W, N, window + 1, 2)`` targets, oldest first (changed in place)."""
+        return self._history
 
     def clear(self, worlds: np.ndarray | slice) -> None:
         """Forget the history of ``worlds`` (a new episode)."""
@@ -69,23 +73,29 @@ class OscillationHistory:
 @compiled
 def _oscillation_update(history: np.ndarray, targets: np.ndarray, out: np.ndarray) -> None:
     """:meth:`OscillationHistory.update` on its ``(W, N, window + 1, 2)`` history."""
-    depth = history.shape[2]
     for w in range(targets.shape[0]):
         for n in range(targets.shape[1]):
-            row, col = targets[w, n, 0], targets[w, n, 1]
-            last_row, last_col = history[w, n, depth - 1, 0], history[w, n, depth - 1, 1]
-            flag = False
-            if row >= 0 and last_row >= 0 and (row != last_row or col != last_col):
-                for i in range(depth - 1):
-                    if history[w, n, i, 0] == row and history[w, n, i, 1] == col:
-                        flag = True
-                        break
-            out[w, n] = flag
-            for i in range(depth - 1):
-                history[w, n, i, 0] = history[w, n, i + 1, 0]
-                history[w, n, i, 1] = history[w, n, i + 1, 1]
-            history[w, n, depth - 1, 0] = row
-            history[w, n, depth - 1, 1] = col
+            out[w, n] = oscillation_step(history[w, n], targets[w, n, 0], targets[w, n, 1])
+
+
+@compiled
+def oscillation_step(history: np.ndarray, row: int, col: int) -> bool:
+    """One robot's oscillation test on its ``(window + 1, 2)`` history, which then records
+    the target (row, col)."""
+    depth = history.shape[0]
+    last_row, last_col = history[depth - 1, 0], history[depth - 1, 1]
+    flag = False
+    if row >= 0 and last_row >= 0 and (row != last_row or col != last_col):
+        for i in range(depth - 1):
+            if history[i, 0] == row and history[i, 1] == col:
+                flag = True
+                break
+    for i in range(depth - 1):
+        history[i, 0] = history[i + 1, 0]
+        history[i, 1] = history[i + 1, 1]
+    history[depth - 1, 0] = row
+    history[depth - 1, 1] = col
+    return flag
 
 
 class OscillationDetector:
@@ -170,6 +180,7 @@ def batch_outcome(
     travel = cfg.kind == "travel"
     if travel and moved is None:
         raise ValueError("the travel reward needs the cells each robot walked")
+    new_cells = np.asarray(new_cells, dtype=np.int64)
     worlds, robots = new_cells.shape
     outcome = BatchOutcome(
         np.empty((worlds, robots)),
@@ -183,14 +194,14 @@ def batch_outcome(
         cfg.padding_truncates,
         cfg.no_progress_limit,
         cfg.max_steps,
-        np.asarray(new_cells, dtype=np.int64),
+        new_cells,
         np.asarray(padding, dtype=np.bool_),
         np.asarray(oscillation, dtype=np.bool_),
         np.asarray(threshold_reached, dtype=np.bool_),
         np.asarray(no_frontier_left, dtype=np.bool_),
         np.asarray(steps_taken, dtype=np.int64),
         np.asarray(steps_without_progress, dtype=np.int64),
-        np.zeros_like(new_cells, dtype=np.int64) if moved is None else moved.astype(np.int64),
+        new_cells if moved is None else np.asarray(moved, dtype=np.int64),  # read by travel only
         outcome.rewards,
         outcome.terminated,
         outcome.truncated,
@@ -199,9 +210,23 @@ def batch_outcome(
     return outcome
 
 
-@functools.lru_cache(maxsize=64)
+#: The reward table's constants by config, found by identity (hashing a config costs more
+#: than the table): ``id(cfg) -> (cfg, constants)``, the config kept so its id stays its own.
+_CONSTANTS: dict[int, tuple[RewardConfig, np.ndarray]] = {}
+
+
 def _constants(cfg: RewardConfig) -> np.ndarray:
     """The reward table's constants, in :func:`_reward_table`'s order."""
+    cached = _CONSTANTS.get(id(cfg))
+    if cached is not None and cached[0] is cfg:
+        return cached[1]
+    if len(_CONSTANTS) >= 64:
+        _CONSTANTS.clear()
+    _CONSTANTS[id(cfg)] = (cfg, _table_constants(cfg))
+    return _CONSTANTS[id(cfg)][1]
+
+
+def _table_constants(cfg: RewardConfig) -> np.ndarray:
     travel = cfg.kind == "travel"
     constants = np.array(
         [

@@ -1,0 +1,55 @@
+"""Actions to targets: the compiled calls that turn slot choices into the cells the robots head
+for (with the padding flags and the oscillation test), and tell where they still head after
+the walk, for a batch of worlds. Outputs are passed in: numba boxes returned arrays slowly."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from frontier_marl.core.compiled import compiled
+from frontier_marl.sim.rewards import oscillation_step
+
+
+@compiled
+def decide(
+    live: np.ndarray,
+    target: np.ndarray,
+    actions: np.ndarray,
+    active: np.ndarray,
+    history: np.ndarray,
+    targets: np.ndarray,
+    padding: np.ndarray,
+    oscillation: np.ndarray,
+) -> None:
+    """``targets`` (W, N, 2), ``padding`` and ``oscillation`` (W, N) of W worlds of N robots:
+    ``live`` (W, N) and ``target`` (W, N, S, 2) are the slot tables' live counts and targets,
+    ``actions`` (W, N) the chosen slots (valid indices), ``active`` (W,) the worlds that step
+    and ``history`` the :class:`~frontier_marl.sim.rewards.OscillationHistory` array, updated
+    for those worlds. A robot whose slot is live heads for its target; otherwise (a padding
+    slot) it idles (row -1), flagged ``padding`` when a live slot existed. Inactive worlds:
+    rows -1, no flags."""
+    targets[:] = -1
+    padding[:] = False
+    oscillation[:] = False
+    for w in range(actions.shape[0]):
+        if not active[w]:
+            continue
+        for n in range(actions.shape[1]):
+            slot = actions[w, n]
+            if slot < live[w, n]:  # live slots come first
+                targets[w, n, 0] = target[w, n, slot, 0]
+                targets[w, n, 1] = target[w, n, slot, 1]
+            else:
+                padding[w, n] = live[w, n] > 0
+            oscillation[w, n] = oscillation_step(history[w, n], targets[w, n, 0], targets[w, n, 1])
+
+
+@compiled
+def heading_of(targets: np.ndarray, reached: np.ndarray, heading: np.ndarray) -> None:
+    """``heading`` (W, N, 2): the cells the robots head to after a step, their ``targets``
+    (W, N, 2) where they have one and have not ``reached`` it (W, N), row -1 elsewhere."""
+    for w in range(targets.shape[0]):
+        for n in range(targets.shape[1]):
+            going = targets[w, n, 0] >= 0 and not reached[w, n]
+            heading[w, n, 0] = targets[w, n, 0] if going else -1
+            heading[w, n, 1] = targets[w, n, 1] if going else -1
