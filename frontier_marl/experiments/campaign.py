@@ -131,8 +131,6 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
     A run folder that already holds a finished run with ``evaluation.json`` for this budget
     and number of episodes is reused; one with a checkpoint is resumed.
     """
-    from frontier_marl.training.train import resume_experiment, train
-
     started = time.perf_counter()
     run_dir = Path(spec.run_dir)
     _check_same_experiment(run_dir, spec)
@@ -141,35 +139,37 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
         row["config"] = spec.config
         row["reused"] = True
     else:
-        experiment = experiment_from_dict(spec.experiment, source=spec.config)
-        checkpoint = newest_good_checkpoint(run_dir)
-        if checkpoint is not None:
-            settings = spec.experiment["train"]
-            experiment = resume_experiment(
-                checkpoint,
-                {
-                    key: settings[key]
-                    for key in ("total_timesteps", "eval_episodes", "torch_threads")
-                },
-            )
-        # the campaign owns its run folders: an unfinished run without a checkpoint restarts
-        result = train(experiment, run_dir, resume=checkpoint, progress_bar=False, overwrite=True)
-        if result.interrupted or result.evaluation is None:
-            raise RuntimeError(
-                f"training of {spec.name} was interrupted at step {result.num_timesteps}"
-            )
-        row = summary_row(
-            result.evaluation,
-            config=spec.config,
-            seed=spec.seed,
-            steps=result.num_timesteps,
-            wall_time_s=training_wall_time(run_dir) or result.wall_time_s,
-            run_dir=run_dir,
-        )
+        row = _train_trial(spec, run_dir)
         row["reused"] = False
     row["status"] = "ok"
     row["trial_wall_time_s"] = round(time.perf_counter() - started, 2)
     return row
+
+
+def _train_trial(spec: TrialSpec, run_dir: Path) -> dict[str, Any]:
+    """Train (resuming from the newest checkpoint) and evaluate; the run's summary row."""
+    from frontier_marl.training.train import resume_experiment, train
+
+    experiment = experiment_from_dict(spec.experiment, source=spec.config)
+    checkpoint = newest_good_checkpoint(run_dir)
+    if checkpoint is not None:
+        settings = spec.experiment["train"]
+        keys = ("total_timesteps", "eval_episodes", "torch_threads")
+        experiment = resume_experiment(checkpoint, {key: settings[key] for key in keys})
+    # the campaign owns its run folders: an unfinished run without a checkpoint restarts
+    result = train(experiment, run_dir, resume=checkpoint, progress_bar=False, overwrite=True)
+    if result.interrupted or result.evaluation is None:
+        raise RuntimeError(
+            f"training of {spec.name} was interrupted at step {result.num_timesteps}"
+        )
+    return summary_row(
+        result.evaluation,
+        config=spec.config,
+        seed=spec.seed,
+        steps=result.num_timesteps,
+        wall_time_s=training_wall_time(run_dir) or result.wall_time_s,
+        run_dir=run_dir,
+    )
 
 
 def _check_same_experiment(run_dir: Path, spec: TrialSpec) -> None:

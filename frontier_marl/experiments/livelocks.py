@@ -33,10 +33,31 @@ from frontier_marl.utils.set_options import parse_set_options
 STUCK = ("no_progress", "step_limit")
 
 
-def stuck_episode(
+def _decision(info: dict[str, Any], action: int) -> dict[str, Any]:
+    """What one decision did: the robot's cell, the chosen and the previous target, whether
+    the previous target was still offered, and the chosen slot's distance and path ranks."""
+    table = slot_table(info)
+    target = tuple(table.target[action].tolist()) if action < table.live else None
+    offered = {tuple(t) for t in table.target[: table.live].tolist()}
+    previous = target_cell(info["target"])
+    return {
+        "position": tuple(info["position"].tolist()),
+        "target": target,
+        "previous": previous,
+        "previous_offered": previous in offered,
+        "distance_rank": int((table.distance[: table.live] < table.distance[action]).sum())
+        if target
+        else None,
+        "path_rank": int((table.path_length[: table.live] < table.path_length[action]).sum())
+        if target
+        else None,
+    }
+
+
+def _play(
     env_kwargs: dict[str, Any], policy_name: str, options: dict[str, Any], seed: int
-) -> dict[str, Any] | None:
-    """The record of episode ``seed`` if it ends stuck, else ``None``."""
+) -> tuple[list[dict[str, Any]], dict[str, Any], int]:
+    """Play episode ``seed``: every decision, the last info, and the no-progress limit."""
     env = FrontierParallelEnv(**env_kwargs)
     policy = make_policy(policy_name, seed, **options)
     policy.attach(env)
@@ -44,34 +65,21 @@ def stuck_episode(
     observations, infos = env.reset(seed=seed)
     history: list[dict[str, Any]] = []
     while env.agents:
-        info = infos["robot_0"]
         action = policy.act_team(observations, infos)["robot_0"]
-        table = slot_table(info)
-        target = tuple(table.target[action].tolist()) if action < table.live else None
-        offered = {tuple(t) for t in table.target[: table.live].tolist()}
-        previous = target_cell(info["target"])
-        history.append(
-            {
-                "position": tuple(info["position"].tolist()),
-                "target": target,
-                "previous": previous,
-                "previous_offered": previous in offered,
-                "distance_rank": int((table.distance[: table.live] < table.distance[action]).sum())
-                if target
-                else None,
-                "path_rank": int(
-                    (table.path_length[: table.live] < table.path_length[action]).sum()
-                )
-                if target
-                else None,
-            }
-        )
+        history.append(_decision(infos["robot_0"], action))
         observations, _, _, _, infos = env.step({"robot_0": action})
-    last = next(iter(infos.values()))
+    return history, next(iter(infos.values())), env.config.reward.no_progress_limit
+
+
+def stuck_episode(
+    env_kwargs: dict[str, Any], policy_name: str, options: dict[str, Any], seed: int
+) -> dict[str, Any] | None:
+    """The record of episode ``seed`` if it ends stuck, else ``None``."""
+    history, last, limit = _play(env_kwargs, policy_name, options, seed)
     reason = reason_name(last["end_reason"])
     if not any(cause in reason for cause in STUCK):
         return None
-    window = history[-env.config.reward.no_progress_limit :]
+    window = history[-limit:]
     targets = [h["target"] for h in window]
     switches = [h for h in window if h["previous"] is not None and h["target"] != h["previous"]]
     alternating = len(set(targets)) >= 2 and all(
@@ -93,7 +101,7 @@ def stuck_episode(
     }
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--preset", default="thesis-20x20")
     parser.add_argument("--map-mode", default="static", choices=["static", "dynamic"])
@@ -111,7 +119,24 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    args = parser.parse_args(argv)
+    return parser.parse_args(argv)
+
+
+def _print_policy(name: str, stuck: list[dict[str, Any]], episodes: int) -> None:
+    kinds = Counter("cycle" if r["alternating"] else "other" for r in stuck)
+    print(f"{name}: {len(stuck)}/{episodes} stuck {dict(kinds)}")
+    for r in stuck:
+        print(
+            f"  seed {r['seed']}: {r['end_reason']} at {100 * r['coverage']:.0f} %, "
+            f"{r['distinct_targets']} targets / {r['distinct_cells']} cells in the last "
+            f"window, {r['switches']} switches ({r['switches_while_previous_offered']} "
+            f"with the previous target still offered, {r['switches_to_a_farther_path']} "
+            "to a target farther by path)"
+        )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parse_args(argv)
     env_kwargs: dict[str, Any] = {"preset": args.preset, "map_mode": args.map_mode}
     if args.map is not None:
         env_kwargs = {"preset": args.preset, "map_path": resolve_map(args.map)}
@@ -131,17 +156,7 @@ def main(argv: list[str] | None = None) -> int:
         report[name] = stuck
     bar.close()
     for name in policies:
-        stuck = report[name]
-        kinds = Counter("cycle" if r["alternating"] else "other" for r in stuck)
-        print(f"{name}: {len(stuck)}/{args.episodes} stuck {dict(kinds)}")
-        for r in stuck:
-            print(
-                f"  seed {r['seed']}: {r['end_reason']} at {100 * r['coverage']:.0f} %, "
-                f"{r['distinct_targets']} targets / {r['distinct_cells']} cells in the last "
-                f"window, {r['switches']} switches ({r['switches_while_previous_offered']} "
-                f"with the previous target still offered, {r['switches_to_a_farther_path']} "
-                "to a target farther by path)"
-            )
+        _print_policy(name, report[name], args.episodes)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=1) + "\n")
         print(f"wrote {args.json}", file=sys.stderr)

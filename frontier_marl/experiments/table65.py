@@ -292,12 +292,6 @@ def checks(cells: dict[str, Cell], default: dict[str, Cell]) -> dict[str, Any]:
         == default[f"{CALIBRATION[0]} {CALIBRATION[1]} {h}"].episodes
         for h in HEURISTICS
     }
-    changed = {}  # cell -> [episodes changed, of which the default ended at the threshold]
-    for key, cell in cells.items():
-        pairs = list(zip(cell.episodes, default[key].episodes, strict=True))
-        differ = [old for new, old in pairs if new != old]
-        if differ:
-            changed[key] = [len(differ), sum(old[1] == "threshold" for old in differ)]
     return {
         "known_within": known,
         "unknown_moved": moved,
@@ -305,8 +299,50 @@ def checks(cells: dict[str, Cell], default: dict[str, Cell]) -> dict[str, Any]:
         "dynamic_lower_and_wider": dynamic,
         "calibration_rows_identical": calibration,
         "all": all(known.values()) and ahead and dynamic and all(calibration.values()),
-        "changed_episodes": changed,
+        "changed_episodes": _changed_episodes(cells, default),
     }
+
+
+def _changed_episodes(cells: dict[str, Cell], default: dict[str, Cell]) -> dict[str, list[int]]:
+    """Cell -> [episodes changed, of which the default ended at the threshold]."""
+    changed = {}
+    for key, cell in cells.items():
+        pairs = list(zip(cell.episodes, default[key].episodes, strict=True))
+        differ = [old for new, old in pairs if new != old]
+        if differ:
+            changed[key] = [len(differ), sum(old[1] == "threshold" for old in differ)]
+    return changed
+
+
+def _print_candidate(
+    name: str, candidate: Candidate, cells: dict[str, Cell], verdict: dict[str, Any]
+) -> None:
+    """A candidate's cells, setting by setting, and its verdict."""
+    print(f"\n{name}: {candidate.note}")
+    for preset, mode in SETTINGS:
+        row = "   ".join(
+            f"{h.split('-')[1]} {c.mean:6.2f} ± {c.std:.2f} ({c.terminations:3d} term.)"
+            for h in HEURISTICS
+            for c in [cells[f"{preset} {mode} {h}"]]
+        )
+        print(f"  {preset} {mode:7s}  {row}")
+    within = sum(verdict["known_within"].values())
+    moved = ", ".join(
+        f"{k.replace('thesis-', '')} {v:+.2f}" for k, v in verdict["unknown_moved"].items()
+    )
+    changed = ", ".join(
+        f"{k.replace('thesis-', '')} {n} ({finished} had reached the threshold)"
+        for k, (n, finished) in verdict["changed_episodes"].items()
+    )
+    print(
+        f"  known cells within one thesis std: {within}/{len(verdict['known_within'])}; "
+        f"(a) GD ahead everywhere: {verdict['gd_ahead_everywhere']}; "
+        f"(b) dynamic lower and wider: {verdict['dynamic_lower_and_wider']}; "
+        f"calibration rows identical: {verdict['calibration_rows_identical']}"
+    )
+    print(f"  unknown cells moved: {moved}")
+    print(f"  episodes changed from the default: {changed or 'none'}")
+    print(f"  every criterion: {verdict['all']}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -335,31 +371,7 @@ def main(argv: list[str] | None = None) -> int:
                 **verdict,
             }
         )
-        print(f"\n{name}: {candidate.note}")
-        for preset, mode in SETTINGS:
-            row = "   ".join(
-                f"{h.split('-')[1]} {c.mean:6.2f} ± {c.std:.2f} ({c.terminations:3d} term.)"
-                for h in HEURISTICS
-                for c in [cells[f"{preset} {mode} {h}"]]
-            )
-            print(f"  {preset} {mode:7s}  {row}")
-        within = sum(verdict["known_within"].values())
-        moved = ", ".join(
-            f"{k.replace('thesis-', '')} {v:+.2f}" for k, v in verdict["unknown_moved"].items()
-        )
-        changed = ", ".join(
-            f"{k.replace('thesis-', '')} {n} ({finished} had reached the threshold)"
-            for k, (n, finished) in verdict["changed_episodes"].items()
-        )
-        print(
-            f"  known cells within one thesis std: {within}/{len(verdict['known_within'])}; "
-            f"(a) GD ahead everywhere: {verdict['gd_ahead_everywhere']}; "
-            f"(b) dynamic lower and wider: {verdict['dynamic_lower_and_wider']}; "
-            f"calibration rows identical: {verdict['calibration_rows_identical']}"
-        )
-        print(f"  unknown cells moved: {moved}")
-        print(f"  episodes changed from the default: {changed or 'none'}")
-        print(f"  every criterion: {verdict['all']}")
+        _print_candidate(name, candidate, cells, verdict)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=1) + "\n")
     return 0

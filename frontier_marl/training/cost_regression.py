@@ -54,6 +54,18 @@ def scorer_config(world: EnvConfig) -> EnvConfig:
     return make_config(None, **{**world_settings(world), **MAP_EXPLORER_SETTINGS})
 
 
+def _round_record(
+    model: Any, validation: Validation, reg: RegressionSettings, round_: int, n_labels: int
+) -> dict[str, Any]:
+    """Validate ``model`` at every rule weight; the record of the round at the best one."""
+    tried = {weight: validation(model, weight) for weight in reg.rule_weights}
+    weight = max(tried, key=lambda w: tried[w]["score"])
+    record = {"round": round_, "labels": n_labels, **tried[weight]}
+    record["rule_weight"] = weight
+    record["by_rule_weight"] = {str(w): t["vs_frontier_rule"] for w, t in tried.items()}
+    return record
+
+
 def train_cost_regression(
     experiment: Experiment, run_dir: Path, progress_bar: bool = True
 ) -> TrainResult:
@@ -80,11 +92,7 @@ def train_cost_regression(
         samples.save(run_dir / "labels" / f"round{round_}.npz")
         labels.append(samples)
         model = fitted(Samples.join(labels), reg, settings.seed + round_)
-        tried = {weight: validation(model, weight) for weight in reg.rule_weights}
-        weight = max(tried, key=lambda w: tried[w]["score"])
-        record = {"round": round_, "labels": len(Samples.join(labels)), **tried[weight]}
-        record["rule_weight"] = weight
-        record["by_rule_weight"] = {str(w): t["vs_frontier_rule"] for w, t in tried.items()}
+        record = _round_record(model, validation, reg, round_, len(Samples.join(labels)))
         record["wall_s"] = time.perf_counter() - started
         with log.open("a") as handle:
             handle.write(json.dumps(record) + "\n")
@@ -96,16 +104,21 @@ def train_cost_regression(
         bar.set_postfix(vs_rule=f"{-record['score']:+.1%}")
     bar.close()
     save_map_explorer(model, run_dir, meta)
+    return _result(run_dir, len(Samples.join(labels)), started, cpu_started)
+
+
+def _result(run_dir: Path, n_labels: int, started: float, cpu_started: float) -> TrainResult:
+    """The run's result: the labels count as its steps."""
     wall = time.perf_counter() - started
     return TrainResult(
         run_dir=run_dir,
         model_path=run_dir / "model.pt",
-        num_timesteps=len(Samples.join(labels)),
-        steps_this_session=len(Samples.join(labels)),
+        num_timesteps=n_labels,
+        steps_this_session=n_labels,
         wall_time_s=wall,
         cpu_time_s=time.process_time() - cpu_started,
         interrupted=False,
-        files={"model": run_dir / "model.pt", "best": run_dir / "best", "log": log},
+        files={"model": run_dir / "model.pt", "best": run_dir / "best", "log": run_dir / LOG_FILE},
     )
 
 

@@ -83,8 +83,72 @@ def plot_learning_curve(
     plot_learning_curves([("", metrics, validation)], path, title, reference)
 
 
+#: (label, metrics rows, validation records) of one run of :func:`plot_learning_curves`.
+RunCurves = tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]
+
+
+def _plot_run(axes: Sequence[Any], i: int, run: RunCurves) -> None:
+    """One run's reward, validation, loss and epsilon curves, in colour ``C{i}``."""
+    reward, loss, eps = axes
+    label, metrics, validation = run
+    colour = f"C{i}"
+    prefix = f"{label}: " if label else ""
+    steps, values = _series(metrics, "rollout/ep_rew_mean")
+    reward.plot(steps, values, color=colour, label=f"{prefix}training episodes (epsilon-greedy)")
+    steps, values = _series(validation, "mean_reward")
+    if len(steps):
+        reward.plot(
+            steps,
+            values,
+            color=colour,
+            marker=".",
+            linewidth=0.6,
+            linestyle="--",
+            label=f"{prefix}greedy, validation",
+        )
+    steps, values = _series(metrics, "train/loss")
+    loss.plot(steps, values, color=colour, linewidth=0.8, label=label or None)
+    steps, values = _series(metrics, "rollout/exploration_rate")
+    eps.plot(steps, values, color=colour)
+
+
+def _finish_curve_axes(
+    axes: Sequence[Any], runs: Sequence[RunCurves], reference: Mapping[str, float] | None
+) -> None:
+    """Reference lines, legends, scales, titles and labels of the three panels."""
+    reward, loss, eps = axes
+    styles = (":", "-.", (0, (5, 2)), (0, (1, 3)))
+    for i, (label, value) in enumerate((reference or {}).items()):
+        reward.axhline(
+            value, color="0.25", linestyle=styles[i % len(styles)], linewidth=1, label=label
+        )
+    if reward.lines and (reference or len(runs) > 1 or any(v for _l, _m, v in runs)):
+        reward.legend(fontsize=7, loc="lower right")
+    reward.set_title("episode reward (rolling mean of 100)", fontsize=9)
+    values = np.concatenate([_series(m, "train/loss")[1] for _l, m, _v in runs] or [[]])
+    if len(values) and np.all(values > 0):
+        loss.set_yscale("log")
+    if len(runs) > 1:
+        loss.legend(fontsize=7, loc="upper right")
+    loss.set_title("TD loss (Huber)", fontsize=9)
+    eps.set_ylim(0, 1.05)
+    eps.set_title("epsilon", fontsize=9)
+    for ax in axes:
+        ax.set_xlabel("environment steps")
+        if not ax.lines:
+            ax.text(
+                0.5,
+                0.5,
+                "no data yet",
+                ha="center",
+                va="center",
+                transform=ax.transAxes,
+                color="0.5",
+            )
+
+
 def plot_learning_curves(
-    runs: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]],
+    runs: Sequence[RunCurves],
     path: str | os.PathLike[str],
     title: str | None = None,
     reference: Mapping[str, float] | None = None,
@@ -92,58 +156,11 @@ def plot_learning_curves(
     """:func:`plot_learning_curve` with several runs overlaid, one colour each: ``runs`` holds
     (label, metrics rows, validation records) per run, e.g. one per seed."""
     plt = _pyplot()
-    fig, (reward, loss, eps) = plt.subplots(1, 3, figsize=(13, 3.6))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
     try:
-        for i, (label, metrics, validation) in enumerate(runs):
-            colour = f"C{i}"
-            prefix = f"{label}: " if label else ""
-            steps, values = _series(metrics, "rollout/ep_rew_mean")
-            reward.plot(
-                steps, values, color=colour, label=f"{prefix}training episodes (epsilon-greedy)"
-            )
-            steps, values = _series(validation, "mean_reward")
-            if len(steps):
-                reward.plot(
-                    steps,
-                    values,
-                    color=colour,
-                    marker=".",
-                    linewidth=0.6,
-                    linestyle="--",
-                    label=f"{prefix}greedy, validation",
-                )
-            steps, values = _series(metrics, "train/loss")
-            loss.plot(steps, values, color=colour, linewidth=0.8, label=label or None)
-            steps, values = _series(metrics, "rollout/exploration_rate")
-            eps.plot(steps, values, color=colour)
-        styles = (":", "-.", (0, (5, 2)), (0, (1, 3)))
-        for i, (label, value) in enumerate((reference or {}).items()):
-            reward.axhline(
-                value, color="0.25", linestyle=styles[i % len(styles)], linewidth=1, label=label
-            )
-        if reward.lines and (reference or len(runs) > 1 or any(v for _l, _m, v in runs)):
-            reward.legend(fontsize=7, loc="lower right")
-        reward.set_title("episode reward (rolling mean of 100)", fontsize=9)
-        values = np.concatenate([_series(m, "train/loss")[1] for _l, m, _v in runs] or [[]])
-        if len(values) and np.all(values > 0):
-            loss.set_yscale("log")
-        if len(runs) > 1:
-            loss.legend(fontsize=7, loc="upper right")
-        loss.set_title("TD loss (Huber)", fontsize=9)
-        eps.set_ylim(0, 1.05)
-        eps.set_title("epsilon", fontsize=9)
-        for ax in (reward, loss, eps):
-            ax.set_xlabel("environment steps")
-            if not ax.lines:
-                ax.text(
-                    0.5,
-                    0.5,
-                    "no data yet",
-                    ha="center",
-                    va="center",
-                    transform=ax.transAxes,
-                    color="0.5",
-                )
+        for i, run in enumerate(runs):
+            _plot_run(axes, i, run)
+        _finish_curve_axes(axes, runs, reference)
         if title:
             fig.suptitle(title, fontsize=10)
         fig.tight_layout()
