@@ -231,6 +231,11 @@ def require_ray() -> Any:
     return ray
 
 
+def _call(fn: Callable, task: Any) -> Any:
+    """``fn(task)``: what Ray runs (a Python function, whatever ``fn`` is)."""
+    return fn(task)
+
+
 def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Done) -> list:
     ray = require_ray()
     started = not ray.is_initialized()
@@ -245,8 +250,8 @@ def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Don
         except ConnectionError as exc:
             raise ConnectionError(f"ray address {address!r}: cannot connect to Ray: {exc}") from exc
     try:
-        remote = ray.remote(num_cpus=1)(fn)
-        refs = [remote.remote(task) for task in tasks]
+        remote = ray.remote(num_cpus=1)(_call)
+        refs = [remote.remote(fn, task) for task in tasks]
         done.start()
         index = {ref: i for i, ref in enumerate(refs)}
         pending = list(refs)
