@@ -162,3 +162,14 @@ def test_benchmark_on_a_ray_cluster_gives_the_same_rows(ray_address: str, tmp_pa
     subprocess.run(command, check=True, capture_output=True, timeout=300)
     assert main([*BENCH, "--jobs", "1", "--json", str(tmp_path / "one.json")]) == 0
     assert rows_of(out) == rows_of(tmp_path / "one.json")
+
+
+def test_the_speed_script_reports_both_runs(tmp_path: Path) -> None:
+    from frontier_marl.experiments.speed import bench_jobs
+
+    out = tmp_path / "jobs.json"
+    argv = ["--repeats", "1", "--episodes", "2", "--families", "random-20"]
+    assert bench_jobs.main([*argv, "--policies", "nearest-path", "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert [run["jobs"] for run in report["runs"]] == [1, 2] and len(report["speedups"]) == 1
+    assert all(run["wall_s"] > 0 for run in report["runs"])

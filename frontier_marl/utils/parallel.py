@@ -211,8 +211,8 @@ def _result(future: Future, tasks: list, index: int, label: Callable) -> Any:
         return future.result()
     except BrokenProcessPool:
         raise WorkerDied(
-            "a worker process died (killed, out of memory or crashed); the first unfinished "
-            f"task was {label(tasks[index])}"
+            "a worker process died (killed, out of memory or crashed; or a script without "
+            f"`if __name__ == '__main__':`); the first unfinished task was {label(tasks[index])}"
         ) from None
     except Exception as error:
         error.add_note(f"raised in a worker process by {label(tasks[index])}")
