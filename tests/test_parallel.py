@@ -173,3 +173,21 @@ def test_the_speed_script_reports_both_runs(tmp_path: Path) -> None:
     report = json.loads(out.read_text())
     assert [run["jobs"] for run in report["runs"]] == [1, 2] and len(report["speedups"]) == 1
     assert all(run["wall_s"] > 0 for run in report["runs"])
+
+
+@pytest.mark.slow
+def test_cost_regression_labels_are_the_same_in_worker_processes() -> None:
+    pytest.importorskip("torch")
+    import numpy as np
+
+    from frontier_marl.training.cost_regression import label_round
+    from frontier_marl.training.settings import RegressionSettings
+
+    jobs = [("random-20", 1), ("random-20", 2)]
+    one, two = (
+        label_round(jobs, None, RegressionSettings(label_workers=workers), seed=0)
+        for workers in (1, 2)
+    )
+    assert len(one) == len(two) > 0
+    for name in ("crops", "features", "cost", "decision", "family"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(two, name))
