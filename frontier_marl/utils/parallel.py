@@ -8,12 +8,12 @@ deterministic on its own (e.g. one episode from its seed), so the results do not
 where or when it ran.
 
 Worker processes are forked where that is safe (:func:`start_method`: Linux, a parent on one
-Python thread and without torch; it costs nothing), else started by ``forkserver`` (a clean
-server process forks them; each pays the imports and the compiled kernels' cache load once),
-else ``spawn``. A task that raises makes
-:func:`map_tasks` raise that exception with a note naming the task (the tasks not started are
-cancelled); a worker process that dies raises :class:`WorkerDied` naming the tasks it may have
-been running. Ray is an optional extra (``pip install "frontier-marl[ray]"``).
+Python thread and without torch; they start at once), else forked by a ``forkserver`` (a clean
+server process that first imports the modules this process uses: a few seconds, once), else
+spawned. A task that raises makes :func:`map_tasks` raise that exception with a note naming the
+task (the tasks not started are cancelled); a worker process that dies raises
+:class:`WorkerDied` naming the first unfinished task. Nothing waits forever on a lost worker.
+Ray is an optional extra (``pip install "frontier-marl[ray]"``).
 """
 
 from __future__ import annotations
@@ -37,8 +37,6 @@ R = TypeVar("R")
 RAY_HINT = 'Ray is not installed: pip install "frontier-marl[ray]"'
 #: Variables that keep each worker's numeric libraries on one thread (jobs use the cores).
 ONE_THREAD = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
-
-
 #: Libraries a fork server imports once for all workers when this process has imported them.
 HEAVY = ("torch", "stable_baselines3", "sb3_contrib")
 
