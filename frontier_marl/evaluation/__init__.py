@@ -4,6 +4,7 @@
   :mod:`~frontier_marl.evaluation.records`;
 * :mod:`~frontier_marl.evaluation.metrics`: coverage curves, cells to a coverage level, overlap;
 * :mod:`~frontier_marl.evaluation.model_evaluation`: the thesis protocol on a saved model;
+  :mod:`~frontier_marl.evaluation.model_refs`: saved models by path, loaded once per process;
 * :mod:`~frontier_marl.evaluation.plots`: result figures;
 * :mod:`~frontier_marl.evaluation.benchmark`: the exploration benchmark (map families,
   T99/T90, the paired difference to the best heuristic; docs/benchmark.md).

@@ -8,12 +8,12 @@ deterministic on its own (e.g. one episode from its seed), so the results do not
 where or when it ran.
 
 Worker processes are forked where that is safe (:func:`start_method`: Linux, a parent on one
-Python thread and without torch; it costs nothing), else started by ``forkserver`` (a clean
-server process forks them; each pays the imports and the compiled kernels' cache load once),
-else ``spawn``. A task that raises makes
-:func:`map_tasks` raise that exception with a note naming the task (the tasks not started are
-cancelled); a worker process that dies raises :class:`WorkerDied` naming the tasks it may have
-been running. Ray is an optional extra (``pip install "frontier-marl[ray]"``).
+Python thread and without torch; they start at once), else forked by a ``forkserver`` (a clean
+server process that first imports the modules this process uses: a few seconds, once), else
+spawned. A task that raises makes :func:`map_tasks` raise that exception with a note naming the
+task (the tasks not started are cancelled); a worker process that dies raises
+:class:`WorkerDied` naming the first unfinished task. Nothing waits forever on a lost worker.
+Ray is an optional extra (``pip install "frontier-marl[ray]"``).
 """
 
 from __future__ import annotations
@@ -37,8 +37,6 @@ R = TypeVar("R")
 RAY_HINT = 'Ray is not installed: pip install "frontier-marl[ray]"'
 #: Variables that keep each worker's numeric libraries on one thread (jobs use the cores).
 ONE_THREAD = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
-
-
 #: Libraries a fork server imports once for all workers when this process has imported them.
 HEAVY = ("torch", "stable_baselines3", "sb3_contrib")
 
@@ -211,8 +209,8 @@ def _result(future: Future, tasks: list, index: int, label: Callable) -> Any:
         return future.result()
     except BrokenProcessPool:
         raise WorkerDied(
-            "a worker process died (killed, out of memory or crashed); the first unfinished "
-            f"task was {label(tasks[index])}"
+            "a worker process died (killed, out of memory or crashed; or a script without "
+            f"`if __name__ == '__main__':`); the first unfinished task was {label(tasks[index])}"
         ) from None
     except Exception as error:
         error.add_note(f"raised in a worker process by {label(tasks[index])}")
@@ -231,6 +229,11 @@ def require_ray() -> Any:
     return ray
 
 
+def _call(fn: Callable, task: Any) -> Any:
+    """``fn(task)``: what Ray runs (a Python function, whatever ``fn`` is)."""
+    return fn(task)
+
+
 def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Done) -> list:
     ray = require_ray()
     started = not ray.is_initialized()
@@ -245,8 +248,8 @@ def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Don
         except ConnectionError as exc:
             raise ConnectionError(f"ray address {address!r}: cannot connect to Ray: {exc}") from exc
     try:
-        remote = ray.remote(num_cpus=1)(fn)
-        refs = [remote.remote(task) for task in tasks]
+        remote = ray.remote(num_cpus=1)(_call)
+        refs = [remote.remote(fn, task) for task in tasks]
         done.start()
         index = {ref: i for i, ref in enumerate(refs)}
         pending = list(refs)

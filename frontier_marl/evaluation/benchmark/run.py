@@ -18,6 +18,11 @@ can deadlock head-on with a teammate in a corridor while nothing new is seen). A
 keeps its own observation settings (:data:`OBSERVATION_KEYS`, from its saved metadata) and takes
 everything else (map, sensor, movement, episode end) from the family.
 
+One episode (:class:`EpisodeTask`: a policy, a world, a reset seed) is the unit of work: a run
+plays its episodes with :func:`~frontier_marl.utils.parallel.map_tasks`, in this process, in
+worker processes (``jobs``) or on a Ray cluster (``ray_address``), each with a fresh policy and
+env (:func:`play_episode`), and reassembles them in order: the same rows wherever they ran. The
+policies are in :mod:`~frontier_marl.evaluation.benchmark.contenders` (re-exported here).
 Statistics (T99, T90, success, the paired difference to the best heuristic) are in
 :mod:`frontier_marl.evaluation.benchmark.stats`.
 """
