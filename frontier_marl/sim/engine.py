@@ -255,7 +255,9 @@ class ExplorationMDP:
         after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        heading = self._heading(targets, reached)
+        obs = self.cfg.observation
+        heads = obs.features == "explorer" or obs.teammates == "positions+targets"
+        heading = self._heading(targets, reached) if heads else None  # read by those alone
         mates = self._teammate_table(positions, heading)
         motion = None if self._trail is None else self._trail.motion(0, positions)
         batch = self.encoder.encode_batch(
@@ -287,7 +289,9 @@ class ExplorationMDP:
         heading_of(targets[None], reached[None], heading[None])
         return heading
 
-    def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
+    def _teammate_table(
+        self, positions: np.ndarray, heading: np.ndarray | None
+    ) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:
         before its first decision, idle, or on its target, see :func:`observed_heading`); None
         if not observed."""
@@ -296,5 +300,6 @@ class ExplorationMDP:
             return None
         if layout == "positions":
             return positions.astype(np.float64)
+        assert heading is not None
         heading = observed_heading(heading, self.cfg.observation.features)
         return np.concatenate([positions, heading], axis=1).astype(np.float64)
