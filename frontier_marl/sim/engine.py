@@ -24,6 +24,7 @@ from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.sim.rewards import (
+    BatchOutcome,
     OscillationHistory,
     StepOutcome,
     batch_outcome,
@@ -80,6 +81,7 @@ class ExplorationMDP:
         # The reward table's per-world inputs, (1,) arrays refilled every step.
         self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+        self._ends = (np.zeros(1, bool), np.zeros(1, bool), np.zeros(1, np.int64))  # its flags
         self.steps = 0
         self.steps_without_progress = 0
         self.explored = 0.0  # the explored fraction on the threshold's basis, now
@@ -196,6 +198,7 @@ class ExplorationMDP:
             self._steps,
             self._stalled,
             None if travel is None else travel[None],
+            BatchOutcome(np.empty((1, len(new_cells))), *self._ends),  # fresh rewards
         )
         return first_outcome(outcome)
 
@@ -246,7 +249,8 @@ class ExplorationMDP:
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None
-        return list(self._slot_arrays.mask.copy())
+        mask = self._slot_arrays.mask
+        return [mask[agent].copy() for agent in range(len(mask))]
 
     def _observations(
         self, targets: np.ndarray | None, reached: np.ndarray | None
