@@ -334,10 +334,6 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
 
 def first_outcome(outcome: BatchOutcome) -> StepOutcome:
     """World 0 of a batch's outcome, as one world's :class:`StepOutcome`."""
-    return StepOutcome(
-        outcome.rewards[0],
-        bool(outcome.terminated[0]),
-        bool(outcome.truncated[0]),
-        REASONS[int(outcome.reason[0])],
-        int(outcome.reason[0]),
-    )
+    code = int(outcome.reason[0])
+    ended = bool(outcome.terminated[0]), bool(outcome.truncated[0])
+    return StepOutcome(outcome.rewards[0], *ended, REASONS[code], code)
