@@ -198,7 +198,7 @@ def move_result(worlds: Worlds, index: int) -> MoveResult:
     """World ``index``'s part of the batch's last move, as arrays of its own."""
     walked = worlds.walked[index]
     if walked.shape[1] > 16:  # a whole-path buffer: copy only the cells walked
-        walked = walked[:, : int(worlds.walked_len[index].max())]
+        walked = walked[:, : max(worlds.walked_len[index].tolist())]
     return MoveResult(
         worlds.new_cells[index].copy(),
         walked.copy(),

@@ -24,6 +24,7 @@ from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.sim.rewards import (
+    BatchOutcome,
     OscillationHistory,
     StepOutcome,
     batch_outcome,
@@ -80,6 +81,7 @@ class ExplorationMDP:
         # The reward table's per-world inputs, (1,) arrays refilled every step.
         self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+        self._ends = (np.zeros(1, bool), np.zeros(1, bool), np.zeros(1, np.int64))  # its flags
         self.steps = 0
         self.steps_without_progress = 0
         self.explored = 0.0  # the explored fraction on the threshold's basis, now
@@ -196,6 +198,7 @@ class ExplorationMDP:
             self._steps,
             self._stalled,
             None if travel is None else travel[None],
+            BatchOutcome(np.empty((1, len(new_cells))), *self._ends),  # fresh rewards
         )
         return first_outcome(outcome)
 
@@ -246,7 +249,8 @@ class ExplorationMDP:
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None
-        return list(self._slot_arrays.mask.copy())
+        mask = self._slot_arrays.mask
+        return [mask[agent].copy() for agent in range(len(mask))]
 
     def _observations(
         self, targets: np.ndarray | None, reached: np.ndarray | None
@@ -255,7 +259,9 @@ class ExplorationMDP:
         after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        heading = self._heading(targets, reached)
+        obs = self.cfg.observation
+        heads = obs.features == "explorer" or obs.teammates == "positions+targets"
+        heading = self._heading(targets, reached) if heads else None  # read by those alone
         mates = self._teammate_table(positions, heading)
         motion = None if self._trail is None else self._trail.motion(0, positions)
         batch = self.encoder.encode_batch(
@@ -287,7 +293,9 @@ class ExplorationMDP:
         heading_of(targets[None], reached[None], heading[None])
         return heading
 
-    def _teammate_table(self, positions: np.ndarray, heading: np.ndarray) -> np.ndarray | None:
+    def _teammate_table(
+        self, positions: np.ndarray, heading: np.ndarray | None
+    ) -> np.ndarray | None:
         """(N, 2) positions, or (N, 4) positions and current targets (where a robot has none:
         before its first decision, idle, or on its target, see :func:`observed_heading`); None
         if not observed."""
@@ -296,5 +304,6 @@ class ExplorationMDP:
             return None
         if layout == "positions":
             return positions.astype(np.float64)
+        assert heading is not None
         heading = observed_heading(heading, self.cfg.observation.features)
         return np.concatenate([positions, heading], axis=1).astype(np.float64)

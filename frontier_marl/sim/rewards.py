@@ -173,27 +173,29 @@ def batch_outcome(
     steps_taken: np.ndarray,
     steps_without_progress: np.ndarray,
     moved: np.ndarray | None = None,
+    out: BatchOutcome | None = None,
 ) -> BatchOutcome:
     """Apply the reward table to one step of W worlds of N robots: per-robot arrays are
     ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched);
-    ``moved`` (cells walked) is needed by the ``travel`` reward only."""
-    travel = cfg.kind == "travel"
+    ``moved`` (cells walked) is needed by the ``travel`` reward only. The outcome is written
+    into ``out`` when given (arrays of those shapes), into fresh arrays otherwise."""
+    constants, travel, padding_truncates, no_progress_limit, max_steps = _constants(cfg)
     if travel and moved is None:
         raise ValueError("the travel reward needs the cells each robot walked")
     new_cells = np.asarray(new_cells, dtype=np.int64)
     worlds, robots = new_cells.shape
-    outcome = BatchOutcome(
+    outcome = out or BatchOutcome(
         np.empty((worlds, robots)),
         np.empty(worlds, dtype=bool),
         np.empty(worlds, dtype=bool),
         np.empty(worlds, dtype=np.int64),
     )
     _reward_table(
-        _constants(cfg),
+        constants,
         travel,
-        cfg.padding_truncates,
-        cfg.no_progress_limit,
-        cfg.max_steps,
+        padding_truncates,
+        no_progress_limit,
+        max_steps,
         new_cells,
         np.asarray(padding, dtype=np.bool_),
         np.asarray(oscillation, dtype=np.bool_),
@@ -212,17 +214,20 @@ def batch_outcome(
 
 #: The reward table's constants by config, found by identity (hashing a config costs more
 #: than the table): ``id(cfg) -> (cfg, constants)``, the config kept so its id stays its own.
-_CONSTANTS: dict[int, tuple[RewardConfig, np.ndarray]] = {}
+_CONSTANTS: dict[int, tuple[RewardConfig, tuple[np.ndarray, bool, bool, int, int]]] = {}
 
 
-def _constants(cfg: RewardConfig) -> np.ndarray:
-    """The reward table's constants, in :func:`_reward_table`'s order."""
+def _constants(cfg: RewardConfig) -> tuple[np.ndarray, bool, bool, int, int]:
+    """The reward table's constants, in :func:`_reward_table`'s order: the float array, the
+    travel and padding-truncation switches, the no-progress and step limits."""
     cached = _CONSTANTS.get(id(cfg))
     if cached is not None and cached[0] is cfg:
         return cached[1]
     if len(_CONSTANTS) >= 64:
         _CONSTANTS.clear()
-    _CONSTANTS[id(cfg)] = (cfg, _table_constants(cfg))
+    switches = (cfg.kind == "travel", cfg.padding_truncates)
+    limits = (cfg.no_progress_limit, cfg.max_steps)
+    _CONSTANTS[id(cfg)] = (cfg, (_table_constants(cfg), *switches, *limits))
     return _CONSTANTS[id(cfg)][1]
 
 
@@ -329,10 +334,6 @@ def step_outcome(cfg: RewardConfig, events: StepEvents) -> StepOutcome:
 
 def first_outcome(outcome: BatchOutcome) -> StepOutcome:
     """World 0 of a batch's outcome, as one world's :class:`StepOutcome`."""
-    return StepOutcome(
-        outcome.rewards[0],
-        bool(outcome.terminated[0]),
-        bool(outcome.truncated[0]),
-        REASONS[int(outcome.reason[0])],
-        int(outcome.reason[0]),
-    )
+    code = int(outcome.reason[0])
+    ended = bool(outcome.terminated[0]), bool(outcome.truncated[0])
+    return StepOutcome(outcome.rewards[0], *ended, REASONS[code], code)
