@@ -97,6 +97,21 @@ class EnvConfig:
 
     def validate(self) -> None:
         """Raise ``ValueError`` naming the first parameter out of its allowed range."""
+        self._validate_layout()
+        self._validate_map_path()
+        check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
+        check_choice("sensor", self.sensor, get_args(SensorModel))
+        if self.cells_per_step != FULL_PATH:
+            check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
+        check_int("connectivity", self.connectivity, 4, 8)
+        check_choice("connectivity", self.connectivity, (4, 8))
+        check_int("max_cluster_cells", self.max_cluster_cells, 1)
+        check_int("n_slots", self.n_slots, 1, 256)
+        check_choice("gain", self.gain, get_args(GainModel))
+        self._validate_parts()
+
+    def _validate_layout(self) -> None:
+        """Size, team, generator, obstacles, scale and map mode."""
         check_int("height", self.height, 3, 4096)
         check_int("width", self.width, 3, 4096)
         check_int("n_agents", self.n_agents, 1, 64)
@@ -118,24 +133,21 @@ class EnvConfig:
             )
         check_choice("map_mode", self.map_mode, get_args(MapMode))
         check_int("map_seed", self.map_seed, 0)
-        if self.map_path is not None:
-            if not isinstance(self.map_path, str):
-                raise ValueError(f"map_path must be a file path string, got {self.map_path!r}")
-            if self.map_mode != "static":
-                raise ValueError(
-                    "map_mode must be 'static' with map_path (a file holds one fixed layout)"
-                )
-            if self.map_scale != 1:
-                raise ValueError("map_scale applies to generated layouts, not to map_path")
-        check_int("perception_range", self.perception_range, 1, max(self.height, self.width))
-        check_choice("sensor", self.sensor, get_args(SensorModel))
-        if self.cells_per_step != FULL_PATH:
-            check_int("cells_per_step", self.cells_per_step, 1, extra_allowed="'full'")
-        check_int("connectivity", self.connectivity, 4, 8)
-        check_choice("connectivity", self.connectivity, (4, 8))
-        check_int("max_cluster_cells", self.max_cluster_cells, 1)
-        check_int("n_slots", self.n_slots, 1, 256)
-        check_choice("gain", self.gain, get_args(GainModel))
+
+    def _validate_map_path(self) -> None:
+        if self.map_path is None:
+            return
+        if not isinstance(self.map_path, str):
+            raise ValueError(f"map_path must be a file path string, got {self.map_path!r}")
+        if self.map_mode != "static":
+            raise ValueError(
+                "map_mode must be 'static' with map_path (a file holds one fixed layout)"
+            )
+        if self.map_scale != 1:
+            raise ValueError("map_scale applies to generated layouts, not to map_path")
+
+    def _validate_parts(self) -> None:
+        """The observation and reward configs, and the teammates' need for a team."""
         if not isinstance(self.observation, ObservationConfig):
             raise ValueError("observation must be an ObservationConfig")
         if not isinstance(self.reward, RewardConfig):

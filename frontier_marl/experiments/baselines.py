@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from frontier_marl.config import make_config
+from frontier_marl.config import EnvConfig, make_config
 from frontier_marl.config.thesis import heuristic_baseline
 from frontier_marl.evaluation import evaluate
 from frontier_marl.policies import make_policy
@@ -33,6 +33,18 @@ DEFAULT_POLICIES = "greedy-distance,greedy-gain,cost-utility,random"
 THESIS_PROTOCOL: dict[str, dict[str, Any]] = {"greedy-distance": {"commit": "on-cycle"}}
 
 
+def _thesis_comparable(cfg: EnvConfig, preset: str) -> bool:
+    """Whether the thesis's figures apply: its geometry (size, range) with one robot only."""
+    base = make_config(preset)
+    return (
+        cfg.n_agents == 1
+        and cfg.map_path is None
+        and cfg.map_generator == base.map_generator
+        and (cfg.height, cfg.width, cfg.perception_range)
+        == (base.height, base.width, base.perception_range)
+    )
+
+
 def run_baselines(
     env_kwargs: dict[str, Any],
     policies: Sequence[str],
@@ -48,15 +60,7 @@ def run_baselines(
     """
     cfg = make_config(**env_kwargs)
     preset = str(env_kwargs.get("preset", "thesis-20x20"))
-    # The thesis's figures are shown for its geometry (size, range) with one robot only.
-    base = make_config(preset)
-    comparable = (
-        cfg.n_agents == 1
-        and cfg.map_path is None
-        and cfg.map_generator == base.map_generator
-        and (cfg.height, cfg.width, cfg.perception_range)
-        == (base.height, base.width, base.perception_range)
-    )
+    comparable = _thesis_comparable(cfg, preset)
     protocol = comparable and preset.startswith("thesis-")
     rows = []
     with progress_bar(episodes * len(policies), disable=not progress, unit="ep") as bar:
@@ -91,6 +95,35 @@ def _fmt_mean_std(mean: float | None, std: float | None, digits: int = 1) -> str
     return f"{mean:.{digits}f} ± {std:.{digits}f}"
 
 
+def _table_row(row: dict[str, Any], levels: list[str], team: bool) -> list[str]:
+    """One policy's cells of :func:`format_table`."""
+    n = row["episodes"]
+    thesis = (
+        "—"
+        if row.get("thesis_mean") is None
+        else f"{row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
+    )
+    cells = [_fmt_cells(row["cells_to_coverage"][key], n) for key in levels]
+    if team:
+        spans = row.get("makespan_to_coverage", {})
+        cells += [
+            _fmt_mean_std(row.get("mean_makespan"), row.get("std_makespan")),
+            *(_fmt_cells(spans[key], n) if key in spans else "—" for key in levels),
+            _fmt_mean_std(row.get("mean_overlap"), row.get("std_overlap"), 3),
+        ]
+    shares = " ".join(f"{s:.2f}" for s in row["action_shares"])
+    return [
+        row["policy"],
+        f"{row['mean_reward']:.2f} ± {row['std_reward']:.2f}",
+        thesis,
+        f"{row['terminations']}/{n}",
+        f"{row['mean_steps']:.1f}",
+        f"{row['mean_travelled']:.1f}",
+        *cells,
+        shares,
+    ]
+
+
 def format_table(rows: Sequence[dict[str, Any]]) -> str:
     """The results as a plain-text table; with a team (``n_agents > 1``) also the makespan
     (longest single robot path) at the end and to each coverage level, and the overlap."""
@@ -101,35 +134,7 @@ def format_table(rows: Sequence[dict[str, Any]]) -> str:
     if team:
         header += ["makespan", *(f"makespan→{float(key):.0%}" for key in levels), "overlap"]
     header.append("action shares")
-    lines = [header]
-    for row in rows:
-        n = row["episodes"]
-        thesis = (
-            "—"
-            if row.get("thesis_mean") is None
-            else f"{row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
-        )
-        cells = [_fmt_cells(row["cells_to_coverage"][key], n) for key in levels]
-        if team:
-            spans = row.get("makespan_to_coverage", {})
-            cells += [
-                _fmt_mean_std(row.get("mean_makespan"), row.get("std_makespan")),
-                *(_fmt_cells(spans[key], n) if key in spans else "—" for key in levels),
-                _fmt_mean_std(row.get("mean_overlap"), row.get("std_overlap"), 3),
-            ]
-        shares = " ".join(f"{s:.2f}" for s in row["action_shares"])
-        lines.append(
-            [
-                row["policy"],
-                f"{row['mean_reward']:.2f} ± {row['std_reward']:.2f}",
-                thesis,
-                f"{row['terminations']}/{n}",
-                f"{row['mean_steps']:.1f}",
-                f"{row['mean_travelled']:.1f}",
-                *cells,
-                shares,
-            ]
-        )
+    lines = [header, *(_table_row(row, levels, team) for row in rows)]
     widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
     out = []
     for k, line in enumerate(lines):

@@ -38,37 +38,31 @@ def score(env: dict[str, Any], policy: str, commit: str, episodes: int) -> tuple
     return round(result.mean_reward, 2), round(result.std_reward, 2)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--commit", default="none", help="the heuristics' commit rule")
-    parser.add_argument("--episodes", type=int, default=30)
-    parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--no-progress", action="store_true")
-    args = parser.parse_args(argv)
-    total = len(PRESETS) * len(HEURISTICS) * (1 + len(CANDIDATES))
-    bar = progress_bar(total, disable=args.no_progress, unit="row")
-    static = {}
+_Scores = dict[tuple[str, str], tuple[float, float]]
+
+
+def _candidate_row(
+    name: str, kwargs: dict[str, Any], static: _Scores, args: argparse.Namespace, bar: Any
+) -> dict[str, Any]:
+    """A candidate's dynamic-map scores, and whether every cell is lower and wider than the
+    static map's (``pattern``)."""
+    row: dict[str, Any] = {"candidate": name, "env": kwargs}
+    holds = True
     for preset in PRESETS:
         for policy in HEURISTICS:
-            static[preset, policy] = score({"preset": preset}, policy, args.commit, args.episodes)
+            env = {"preset": preset, "map_mode": "dynamic", **kwargs}
+            mean, std = score(env, policy, args.commit, args.episodes)
+            ref_mean, ref_std = static[preset, policy]
+            holds &= mean < ref_mean and std > ref_std
+            row[f"{preset} {policy}"] = [mean, std]
             bar.update(1)
-    rows = []
-    for name, kwargs in CANDIDATES.items():
-        row: dict[str, Any] = {"candidate": name, "env": kwargs}
-        holds = True
-        for preset in PRESETS:
-            for policy in HEURISTICS:
-                env = {"preset": preset, "map_mode": "dynamic", **kwargs}
-                mean, std = score(env, policy, args.commit, args.episodes)
-                ref_mean, ref_std = static[preset, policy]
-                holds &= mean < ref_mean and std > ref_std
-                row[f"{preset} {policy}"] = [mean, std]
-                bar.update(1)
-        row["pattern"] = holds
-        rows.append(row)
-    bar.close()
+    row["pattern"] = holds
+    return row
+
+
+def _print_report(commit: str, static: _Scores, rows: list[dict[str, Any]]) -> None:
     print(
-        f"commit={args.commit}; static: "
+        f"commit={commit}; static: "
         + ", ".join(f"{p} {h} {m:.2f} ± {s:.2f}" for (p, h), (m, s) in static.items())
     )
     for row in rows:
@@ -78,6 +72,25 @@ def main(argv: list[str] | None = None) -> int:
             for h in HEURISTICS
         )
         print(f"{row['candidate']:<36} {cells}  pattern: {'yes' if row['pattern'] else 'no'}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--commit", default="none", help="the heuristics' commit rule")
+    parser.add_argument("--episodes", type=int, default=30)
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    total = len(PRESETS) * len(HEURISTICS) * (1 + len(CANDIDATES))
+    bar = progress_bar(total, disable=args.no_progress, unit="row")
+    static: _Scores = {}
+    for preset in PRESETS:
+        for policy in HEURISTICS:
+            static[preset, policy] = score({"preset": preset}, policy, args.commit, args.episodes)
+            bar.update(1)
+    rows = [_candidate_row(name, kw, static, args, bar) for name, kw in CANDIDATES.items()]
+    bar.close()
+    _print_report(args.commit, static, rows)
     if args.json is not None:
         report = {"commit": args.commit, "static": {f"{p} {h}": v for (p, h), v in static.items()}}
         args.json.write_text(json.dumps({**report, "rows": rows}, indent=1) + "\n")

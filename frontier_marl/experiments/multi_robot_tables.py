@@ -85,6 +85,29 @@ COMPARED = {
 }
 
 
+def _paired(ours: np.ndarray, theirs: np.ndarray) -> dict[str, Any]:
+    """One metric against the baseline on the episodes where both have a value: the means,
+    the relative change with its 95 % half-width, and wins/ties/losses."""
+    both = ~np.isnan(ours) & ~np.isnan(theirs)
+    if not both.any():  # e.g. a policy that never reached the level
+        paired: dict[str, Any] = {"mean": None, "baseline_mean": None, "episodes": 0}
+        paired.update(change=None, ci95=None, wins=0, ties=0, losses=0)
+        return paired
+    mean_ours, mean_theirs = float(ours[both].mean()), float(theirs[both].mean())
+    diff = ours[both] - theirs[both]
+    half = 1.96 * float(diff.std(ddof=1)) / np.sqrt(len(diff)) if len(diff) > 1 else None
+    return {
+        "mean": mean_ours,
+        "baseline_mean": mean_theirs,
+        "episodes": int(both.sum()),
+        "change": (mean_ours - mean_theirs) / mean_theirs if mean_theirs else None,
+        "ci95": half / mean_theirs if half is not None and mean_theirs else None,
+        "wins": int(np.sum(ours[both] < theirs[both])),
+        "ties": int(np.sum(ours[both] == theirs[both])),
+        "losses": int(np.sum(ours[both] > theirs[both])),
+    }
+
+
 def comparison(rows: Sequence[Mapping[str, Any]], baseline: str = BASELINE) -> list[dict]:
     """Each coordinated policy against ``baseline`` on the same episodes, per setting and team
     size > 1: relative change of the mean (negative = better) with the half-width of its 95 %
@@ -107,25 +130,7 @@ def comparison(rows: Sequence[Mapping[str, Any]], baseline: str = BASELINE) -> l
             "policy": row["policy"],
         }
         for metric in COMPARED:
-            ours, theirs = _per_episode(row, metric), _per_episode(base, metric)
-            both = ~np.isnan(ours) & ~np.isnan(theirs)
-            if not both.any():  # e.g. a policy that never reached the level
-                entry[metric] = {"mean": None, "baseline_mean": None, "episodes": 0}
-                entry[metric].update(change=None, ci95=None, wins=0, ties=0, losses=0)
-                continue
-            mean_ours, mean_theirs = float(ours[both].mean()), float(theirs[both].mean())
-            diff = ours[both] - theirs[both]
-            half = 1.96 * float(diff.std(ddof=1)) / np.sqrt(len(diff)) if len(diff) > 1 else None
-            entry[metric] = {
-                "mean": mean_ours,
-                "baseline_mean": mean_theirs,
-                "episodes": int(both.sum()),
-                "change": (mean_ours - mean_theirs) / mean_theirs if mean_theirs else None,
-                "ci95": half / mean_theirs if half is not None and mean_theirs else None,
-                "wins": int(np.sum(ours[both] < theirs[both])),
-                "ties": int(np.sum(ours[both] == theirs[both])),
-                "losses": int(np.sum(ours[both] > theirs[both])),
-            }
+            entry[metric] = _paired(_per_episode(row, metric), _per_episode(base, metric))
         out.append(entry)
     return out
 

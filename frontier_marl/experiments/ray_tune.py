@@ -100,6 +100,18 @@ def restoring_signal_handlers(run: Any) -> Any:
                     signal.signal(getattr(signal, name), handler)
 
 
+def _trial_text(r: dict[str, Any]) -> str:
+    """A finished trial's line: its evaluation, or that it reported none."""
+    if "mean_reward" not in r:
+        return "finished without a result"
+    flag = ", DEGENERATE" if r.get("degenerate") else ""
+    return (
+        f"{r['mean_reward']:.2f} ± {r['std_reward']:.2f}, "
+        f"{int(r['terminations'])}/{int(r['episodes'])} terminations{flag} "
+        f"({r.get('trial_wall_time_s', 0):.0f} s)"
+    )
+
+
 def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
     """A Tune callback (run in the driver): a progress bar over finished trials and one line per
     finished trial. Tune pickles its callbacks, so the bar is made in ``setup``."""
@@ -129,17 +141,7 @@ def _progress_callback(tune: Any, names: Sequence[str], progress: bool) -> Any:
             self.bar.update(1)
 
         def on_trial_complete(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
-            r = trial.last_result or {}
-            if "mean_reward" in r:
-                flag = ", DEGENERATE" if r.get("degenerate") else ""
-                text = (
-                    f"{r['mean_reward']:.2f} ± {r['std_reward']:.2f}, "
-                    f"{int(r['terminations'])}/{int(r['episodes'])} terminations{flag} "
-                    f"({r.get('trial_wall_time_s', 0):.0f} s)"
-                )
-            else:
-                text = "finished without a result"
-            self._done(trial, text)
+            self._done(trial, _trial_text(trial.last_result or {}))
 
         def on_trial_error(self, iteration: int, trials: list, trial: Any, **info: Any) -> None:
             self._done(trial, "FAILED")

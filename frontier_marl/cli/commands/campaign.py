@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 from frontier_marl.cli.arguments import add_set_argument, fail, int_list, positive_int
-from frontier_marl.experiments.campaign import RayNotInstalledError, run_campaign
+from frontier_marl.experiments.campaign import CampaignResult, RayNotInstalledError, run_campaign
 from frontier_marl.experiments.results import format_markdown
 
 
@@ -100,6 +100,40 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
+#: Columns of the table printed at the end (the files hold every column).
+_COLUMNS = (
+    "config",
+    "seed",
+    "steps",
+    "mean_reward",
+    "std_reward",
+    "terminations",
+    "episodes",
+    "action_shares",
+    "degenerate",
+    "thesis",
+    "wall_time_s",
+    "status",
+)
+
+
+def _print_result(result: CampaignResult) -> int:
+    """Print the table, the failed trials and the files; 1 if any trial failed."""
+    print()
+    print(format_markdown(result.rows, _COLUMNS), end="")
+    print(
+        f"\n{len(result.rows)} trial(s) in {result.wall_time_s:.0f} s, {len(result.failed)} failed"
+    )
+    for row in result.failed:
+        print(
+            f"  FAILED {row['config']} seed {row['seed']} steps {row['steps']}: {row.get('error')}",
+            file=sys.stderr,
+        )
+    for label, path in result.files.items():
+        print(f"  {label + ':':<10} {path}")
+    return 1 if result.failed else 0
+
+
 def run(args: argparse.Namespace) -> int:
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     try:
@@ -119,30 +153,4 @@ def run(args: argparse.Namespace) -> int:
         return fail("campaign", str(exc))
     except ValueError as exc:
         return fail("campaign", str(exc))
-    columns = (
-        "config",
-        "seed",
-        "steps",
-        "mean_reward",
-        "std_reward",
-        "terminations",
-        "episodes",
-        "action_shares",
-        "degenerate",
-        "thesis",
-        "wall_time_s",
-        "status",
-    )
-    print()
-    print(format_markdown(result.rows, columns), end="")
-    print(
-        f"\n{len(result.rows)} trial(s) in {result.wall_time_s:.0f} s, {len(result.failed)} failed"
-    )
-    for row in result.failed:
-        print(
-            f"  FAILED {row['config']} seed {row['seed']} steps {row['steps']}: {row.get('error')}",
-            file=sys.stderr,
-        )
-    for label, path in result.files.items():
-        print(f"  {label + ':':<10} {path}")
-    return 1 if result.failed else 0
+    return _print_result(result)

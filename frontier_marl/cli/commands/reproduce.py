@@ -24,11 +24,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from frontier_marl.cli.arguments import fail, int_list, positive_int
 from frontier_marl.experiments.comparison import format_comparison_markdown
-from frontier_marl.experiments.reproduce import DEFAULT_SEEDS, reproduce
+from frontier_marl.experiments.reproduce import DEFAULT_SEEDS, ReproduceResult, reproduce
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -79,8 +81,44 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bars")
 
 
-def _print_summary(result: object) -> None:
-    table = result.table  # type: ignore[attr-defined]
+def _row_line(row: Mapping[str, Any], width: int) -> str:
+    """One comparison row: mean ± std, terminations, degeneracy and the thesis's figures."""
+    thesis = ""
+    if row["thesis_mean"] is not None:
+        thesis = f"   (thesis {row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
+        if row["thesis_terminations"] is not None:
+            thesis += f", {row['thesis_terminations']}/{row['thesis_episodes']}"
+        thesis += ")"
+    flag = "  DEGENERATE" if row["degenerate"] else ""
+    return (
+        f"  {row['policy']:<{width}} {row['mean_reward']:6.2f} ± {row['std_reward']:5.2f}, "
+        f"{row['terminations']}/{row['episodes']} terminations{flag}{thesis}"
+    )
+
+
+#: Labels of the files :func:`_print_files` lists, in order.
+_FILE_LABELS = {
+    "markdown": "table (Markdown)",
+    "json": "table (JSON)",
+    "rewards_figure": "rewards figure",
+    "actions_figure": "actions figure",
+    "learning_curve": "learning curves",
+    "baselines": "heuristic rows",
+}
+
+
+def _print_files(result: ReproduceResult) -> None:
+    print("Files")
+    for key, label in _FILE_LABELS.items():
+        path = result.files.get(key)
+        if path is not None:
+            print(f"  {label + ':':<18} {path}")
+    for run_dir in result.run_dirs:
+        print(f"  {'training run:':<18} {run_dir}")
+
+
+def _print_summary(result: ReproduceResult) -> None:
+    table: Any = result.table  # set: the run was not interrupted
     setting, training = table["setting"], table["training"]
     print("\nSummary")
     print(
@@ -94,17 +132,7 @@ def _print_summary(result: object) -> None:
         )
     width = max(16, *(len(row["policy"]) for row in table["rows"]))
     for row in table["rows"]:
-        thesis = ""
-        if row["thesis_mean"] is not None:
-            thesis = f"   (thesis {row['thesis_mean']:.2f} ± {row['thesis_std']:.2f}"
-            if row["thesis_terminations"] is not None:
-                thesis += f", {row['thesis_terminations']}/{row['thesis_episodes']}"
-            thesis += ")"
-        flag = "  DEGENERATE" if row["degenerate"] else ""
-        print(
-            f"  {row['policy']:<{width}} {row['mean_reward']:6.2f} ± {row['std_reward']:5.2f}, "
-            f"{row['terminations']}/{row['episodes']} terminations{flag}{thesis}"
-        )
+        print(_row_line(row, width))
     spread = table["seed_spread"]
     if len(spread["seeds"]) > 1:
         print(
@@ -113,21 +141,7 @@ def _print_summary(result: object) -> None:
         )
     checks = ", ".join(f"{k} {'ok' if v else 'FAIL'}" for k, v in table["checks"].items())
     print(f"  DQN checks: {checks}")
-    print("Files")
-    labels = {
-        "markdown": "table (Markdown)",
-        "json": "table (JSON)",
-        "rewards_figure": "rewards figure",
-        "actions_figure": "actions figure",
-        "learning_curve": "learning curves",
-        "baselines": "heuristic rows",
-    }
-    for key, label in labels.items():
-        path = result.files.get(key)  # type: ignore[attr-defined]
-        if path is not None:
-            print(f"  {label + ':':<18} {path}")
-    for run_dir in result.run_dirs:  # type: ignore[attr-defined]
-        print(f"  {'training run:':<18} {run_dir}")
+    _print_files(result)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -23,10 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import torch as th
 
+from frontier_marl.config import EnvConfig
 from frontier_marl.evaluation.benchmark.families import family
 from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
 from frontier_marl.training.batched_vec_env import make_batched_vec_env
@@ -63,70 +67,108 @@ def nearest_path_choices(data: Dataset) -> np.ndarray:
     return key.argmin(axis=1)
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=4)
     parser.add_argument("--epochs", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", default=None, help="write the records here")
-    args = parser.parse_args(argv)
-    th.set_num_threads(1)
-    th.manual_seed(args.seed)
-    experiment = load_experiment("explorer-dqn")
-    configs = experiment.env_configs()
-    names = experiment.train.families
-    vec_env = make_batched_vec_env({"config": configs[0]}, 1, args.seed)
-    dqn = {**experiment.dqn, "buffer_size": 1, "learning_starts": 0}
-    model = MaskedDQN(SlotDQNPolicy, vec_env, seed=args.seed, **dqn)
+    return parser.parse_args(argv)
 
-    def student(obs: dict[str, np.ndarray]) -> int:
-        return int(model.policy.predict(obs, deterministic=True)[0])
 
-    validator = FamilyValidator(names, 8, configs[0])
-    rng = np.random.default_rng(args.seed)
-    seeds = [iter(rng.permutation(family(name).train)[:10_000]) for name in names]
+@dataclass
+class _Probe:
+    """The student, its validator, and the random streams of the rounds."""
+
+    configs: list[EnvConfig]
+    names: tuple[str, ...]
+    model: Any
+    validator: FamilyValidator
+    rng: np.random.Generator
+    seeds: list[Iterator[Any]]  # per family: its training seeds, shuffled
+    generator: th.Generator  # the fits' batches
+
+    @classmethod
+    def start(cls, seed: int) -> _Probe:
+        th.set_num_threads(1)
+        th.manual_seed(seed)
+        experiment = load_experiment("explorer-dqn")
+        configs = experiment.env_configs()
+        names = experiment.train.families
+        vec_env = make_batched_vec_env({"config": configs[0]}, 1, seed)
+        dqn = {**experiment.dqn, "buffer_size": 1, "learning_starts": 0}
+        model = MaskedDQN(SlotDQNPolicy, vec_env, seed=seed, **dqn)
+        validator = FamilyValidator(names, 8, configs[0])
+        rng = np.random.default_rng(seed)
+        seeds = [iter(rng.permutation(family(name).train)[:10_000]) for name in names]
+        generator = th.Generator().manual_seed(seed)
+        return cls(configs, names, model, validator, rng, seeds, generator)
+
+    def student(self, obs: dict[str, np.ndarray]) -> int:
+        return int(self.model.policy.predict(obs, deterministic=True)[0])
+
+    def episodes(self) -> list[list[int]]:
+        """The next round's episode seeds, :data:`EPISODES` per family."""
+        return [
+            [int(next(it)) for _ in range(EPISODES[n])]
+            for it, n in zip(self.seeds, self.names, strict=True)
+        ]
+
+
+def _regret_record(model: Any, new: Dataset) -> dict[str, Any]:
+    """The student's and nearest-path's regret on a round's decisions, and how the oracle's
+    choice relates to nearest-path's."""
+    with th.no_grad():
+        obs = {
+            "slots": th.as_tensor(np.stack(new.slots)),
+            "action_mask": th.as_tensor(np.stack(new.masks)),
+        }
+        chosen = model.policy.q_net(obs).argmax(dim=1).numpy()
+    oracle, nearest = oracle_choices(new), nearest_path_choices(new)
+    differ = oracle != nearest
+    return {
+        "regret_student": regrets(new, chosen),
+        "regret_nearest_path": regrets(new, nearest_path_choices(new)),
+        "regret_decisions": len(new),
+        "oracle_differs": float(differ.mean()),
+        "oracle_second_nearest": float(np.mean(path_rank(new, oracle)[differ] == 1)),
+    }
+
+
+def _fit_record(
+    probe: _Probe, data: Dataset, round_: int, epochs: int, started: float
+) -> dict[str, Any]:
+    """Fit the student on ``data`` and validate it; the round's record."""
+    model = probe.model
+    losses = fit(model.policy.q_net, data, epochs, 256, 1e-3, probe.generator)
+    model.policy.q_net_target.load_state_dict(model.policy.q_net.state_dict())
+    validation = probe.validator(model)
+    return {
+        "round": round_,
+        "decisions": len(data),
+        "loss": losses[-1],
+        "t99_vs_nearest_path": validation["t99_vs_nearest_path"],
+        "by_family": validation["by_family"],
+        "seconds": time.perf_counter() - started,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parse_args(argv)
+    probe = _Probe.start(args.seed)
     data, records = Dataset(), []
-    generator = th.Generator().manual_seed(args.seed)
     for round_ in range(args.rounds + 1):
         started = time.perf_counter()
         new = Dataset()
-        episodes = [
-            [int(next(it)) for _ in range(EPISODES[n])] for it, n in zip(seeds, names, strict=True)
-        ]
-        collect(configs, episodes, new, student if round_ else None, 0.5**round_, rng)
+        student = probe.student if round_ else None
+        collect(probe.configs, probe.episodes(), new, student, 0.5**round_, probe.rng)
         if round_:  # the student fitted on rounds < round_, scored on this round's decisions
-            with th.no_grad():
-                obs = {
-                    "slots": th.as_tensor(np.stack(new.slots)),
-                    "action_mask": th.as_tensor(np.stack(new.masks)),
-                }
-                chosen = model.policy.q_net(obs).argmax(dim=1).numpy()
-            records[-1]["regret_student"] = regrets(new, chosen)
-            records[-1]["regret_nearest_path"] = regrets(new, nearest_path_choices(new))
-            records[-1]["regret_decisions"] = len(new)
-            oracle, nearest = oracle_choices(new), nearest_path_choices(new)
-            differ = oracle != nearest
-            records[-1]["oracle_differs"] = float(differ.mean())
-            records[-1]["oracle_second_nearest"] = float(
-                np.mean(path_rank(new, oracle)[differ] == 1)
-            )
+            records[-1].update(_regret_record(probe.model, new))
             print(json.dumps(records[-1]), flush=True)
         if round_ == args.rounds:
             break
         data.extend(new)
-        losses = fit(model.policy.q_net, data, args.epochs, 256, 1e-3, generator)
-        model.policy.q_net_target.load_state_dict(model.policy.q_net.state_dict())
-        validation = validator(model)
-        records.append(
-            {
-                "round": round_,
-                "decisions": len(data),
-                "loss": losses[-1],
-                "t99_vs_nearest_path": validation["t99_vs_nearest_path"],
-                "by_family": validation["by_family"],
-                "seconds": time.perf_counter() - started,
-            }
-        )
+        records.append(_fit_record(probe, data, round_, args.epochs, started))
     if args.json:
         with open(args.json, "w") as handle:
             json.dump({"episodes_per_round": EPISODES, "records": records}, handle, indent=1)

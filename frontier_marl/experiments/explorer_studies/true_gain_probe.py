@@ -22,9 +22,11 @@ import json
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import EnvConfig
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.sensing import reveal
 from frontier_marl.envs.vector import FrontierVectorEnv
@@ -70,7 +72,8 @@ def scorer(names: list[str], weights: dict[str, float], kind: str, weight: float
     return score
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[float], list[str]]:
+    """The options, with the checked weights and gain kinds."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--weights", default="-0.25,-0.1,0.1,0.25", help="weights W of the gain")
     parser.add_argument("--kinds", default="true,belief", help=f"gains among {KINDS}")
@@ -89,25 +92,39 @@ def main(argv: list[str] | None = None) -> int:
     kinds = args.kinds.split(",")
     if not set(kinds) <= set(KINDS):
         parser.error(f"--kinds must be among {KINDS}, got {args.kinds!r}")
+    return args, weights, kinds
+
+
+def _family_rows(
+    family: str,
+    cfg: EnvConfig,
+    seeds: list[int],
+    shipped: dict[str, float],
+    kinds: list[str],
+    weights: list[float],
+) -> list[dict[str, Any]]:
+    """Each gain kind and weight's paired T99 change against the shipped weights."""
+    rows = []
+    names = feature_names(cfg)
+    reference, _ = play_scorer(cfg, seeds, scorer(names, shipped, "true", 0.0))
+    for kind in kinds:
+        for weight in weights:
+            t99, _ = play_scorer(cfg, seeds, scorer(names, shipped, kind, weight))
+            rows.append(
+                {"family": family, "kind": kind, "weight": weight, **paired_change(t99, reference)}
+            )
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    args, weights, kinds = _parse_args(argv)
     experiment = load_experiment("explorer")
     shipped = shipped_weights()
     seeds = list(range(args.first, args.first + args.episodes))
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
-        names = feature_names(cfg)
-        reference, _ = play_scorer(cfg, seeds, scorer(names, shipped, "true", 0.0))
-        for kind in kinds:
-            for weight in weights:
-                t99, _ = play_scorer(cfg, seeds, scorer(names, shipped, kind, weight))
-                rows.append(
-                    {
-                        "family": family,
-                        "kind": kind,
-                        "weight": weight,
-                        **paired_change(t99, reference),
-                    }
-                )
+        rows += _family_rows(family, cfg, seeds, shipped, kinds, weights)
         mine = [row for row in rows if row["family"] == family]
         cells = changes_text({f"{row['kind']} W{row['weight']:+g}": row for row in mine})
         print(f"{family}: {cells}  ({time.perf_counter() - started:.0f} s)", flush=True)

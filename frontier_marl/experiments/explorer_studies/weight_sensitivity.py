@@ -19,9 +19,11 @@ import json
 import time
 from itertools import pairwise
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import EnvConfig
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.training.cem import changes_text, paired_change, play_t99, shipped_weights
@@ -52,13 +54,17 @@ def scaled(weights: np.ndarray, names: list[str], name: str, factor: float) -> n
     return np.array([w * factor if n in chosen else w for w, n in zip(weights, names, strict=True)])
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--directions", default=DIRECTIONS, help="NAME:FACTOR,...")
     parser.add_argument("--seed-sets", default="730000,731000,732000", help="first seeds")
     parser.add_argument("--episodes", type=int, default=64, help="episodes per family and set")
     parser.add_argument("--json", type=Path, default=None)
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _seed_sets(parser: argparse.ArgumentParser, args: argparse.Namespace) -> list[int]:
+    """The first seed of each set, after checking that the sets are disjoint training seeds."""
     if args.episodes < 2:
         parser.error(f"--episodes must be at least 2 (for the standard error), got {args.episodes}")
     try:
@@ -70,6 +76,40 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("the seed sets overlap: space their first seeds at least --episodes apart")
     if ranges[0][0] < TRAIN_SEEDS.start or ranges[-1][1] > TRAIN_SEEDS.stop:
         parser.error(f"every seed set must lie in the training seeds, {TRAIN_SEEDS}")
+    return firsts
+
+
+def _family_rows(
+    family: str,
+    cfg: EnvConfig,
+    firsts: list[int],
+    episodes: int,
+    weights: np.ndarray,
+    names: list[str],
+    directions: list[tuple[str, float]],
+) -> list[dict[str, Any]]:
+    """Each direction's paired T99 change against the shipped weights, on each seed set."""
+    rows = []
+    for first in firsts:
+        seeds = list(range(first, first + episodes))
+        reference, _ = play_t99(cfg, seeds, weights)
+        for name, factor in directions:
+            t99, _ = play_t99(cfg, seeds, scaled(weights, names, name, factor))
+            rows.append(
+                {
+                    "family": family,
+                    "first_seed": first,
+                    "direction": f"{name}:{factor:g}",
+                    **paired_change(t99, reference),
+                }
+            )
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    firsts = _seed_sets(parser, args)
     experiment = load_experiment("explorer")
     names = feature_names(experiment.env_config())  # the same on every family
     try:
@@ -80,19 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
-        for first in firsts:
-            seeds = list(range(first, first + args.episodes))
-            reference, _ = play_t99(cfg, seeds, weights)
-            for name, factor in directions:
-                t99, _ = play_t99(cfg, seeds, scaled(weights, names, name, factor))
-                rows.append(
-                    {
-                        "family": family,
-                        "first_seed": first,
-                        "direction": f"{name}:{factor:g}",
-                        **paired_change(t99, reference),
-                    }
-                )
+        rows += _family_rows(family, cfg, firsts, args.episodes, weights, names, directions)
         mine = [row for row in rows if row["family"] == family]
         cells = changes_text({f"{row['direction']}@{row['first_seed']}": row for row in mine})
         print(f"{family}: {cells}  ({time.perf_counter() - started:.0f} s)", flush=True)

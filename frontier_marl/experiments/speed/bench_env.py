@@ -200,10 +200,7 @@ def dqn_env_share(steps: int, chunks: int = 15) -> dict[str, Any]:
     }
 
 
-def main(argv: list[str] | None = None, *, explore_bench_map: Path | None = None) -> int:
-    """The command line of ``benchmarks/bench_env.py``, which passes Explore-Bench's
-    room1_modified map beside the repository as ``explore_bench_map`` (the default of
-    ``--explore-bench-map``)."""
+def _parse_args(argv: list[str] | None, explore_bench_map: Path | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=8.0, help="timed seconds per setting")
     parser.add_argument("--dqn-steps", type=int, default=30_000)
@@ -218,33 +215,52 @@ def main(argv: list[str] | None = None, *, explore_bench_map: Path | None = None
         default=explore_bench_map,
         help="Explore-Bench PGM map for the side-by-side figure (skipped if absent)",
     )
-    args = parser.parse_args(argv)
+    return parser.parse_args(argv)
+
+
+def _decision_rows(
+    settings: list[tuple[str, dict[str, Any]]], seconds: float
+) -> list[dict[str, Any]]:
+    """Decisions per second of the nearest and the random rule in every setting, printed."""
+    rows = []
+    print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
+    for label, kwargs in settings:
+        for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
+            row = decisions_per_second(kwargs, policy, seconds)
+            rows.append({"setting": label, "policy": policy_name, **row})
+            print(
+                f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
+                f"{row['us_per_decision']:>13.1f}"
+            )
+    return rows
+
+
+def _print_dqn(dqn: dict[str, Any]) -> None:
+    print(
+        f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
+        f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
+        f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} % "
+        f"(standard error over the chunks {100 * dqn['env_share_standard_error']:.1f})"
+    )
+
+
+def main(argv: list[str] | None = None, *, explore_bench_map: Path | None = None) -> int:
+    """The command line of ``benchmarks/bench_env.py``, which passes Explore-Bench's
+    room1_modified map beside the repository as ``explore_bench_map`` (the default of
+    ``--explore-bench-map``)."""
+    args = _parse_args(argv, explore_bench_map)
     settings = list(SETTINGS)
     if args.explore_bench_map is not None and args.explore_bench_map.is_file():
         settings += explore_bench_settings(args.explore_bench_map)
     report: dict[str, Any] = {
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
-        "decisions": [],
+        "decisions": _decision_rows(settings, args.seconds),
     }
-    print(f"{'setting':<24}{'policy':<10}{'decisions/s':>12}{'us/decision':>13}")
-    for label, kwargs in settings:
-        for policy_name, policy in (("nearest", nearest), ("random", random_valid)):
-            row = decisions_per_second(kwargs, policy, args.seconds)
-            report["decisions"].append({"setting": label, "policy": policy_name, **row})
-            print(
-                f"{label:<24}{policy_name:<10}{row['decisions_per_s']:>12.0f}"
-                f"{row['us_per_decision']:>13.1f}"
-            )
     if not args.skip_dqn:
         dqn = dqn_env_share(args.dqn_steps, args.dqn_chunks)
         report["dqn"] = dqn
-        print(
-            f"DQN {dqn['steps']} steps: null env {dqn['seconds_null']:.1f} s, "
-            f"thesis-20x20 env {dqn['seconds_env']:.1f} s "
-            f"({dqn['steps_per_s_env']:.0f} steps/s); env share {100 * dqn['env_share']:.1f} % "
-            f"(standard error over the chunks {100 * dqn['env_share_standard_error']:.1f})"
-        )
+        _print_dqn(dqn)
     if args.json:
         with open(args.json, "w") as handle:
             json.dump(report, handle, indent=2)
