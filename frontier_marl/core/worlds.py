@@ -28,7 +28,7 @@ from frontier_marl.core.frontiers import (
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.sensing import Sensor, reveal
-from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays
 from frontier_marl.core.world_kernels import all_slots, count_known, settle_clusters, walk_worlds
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
@@ -207,9 +207,18 @@ class Worlds:
             self.centroids[world, :count],
         )
 
-    def slots(self, out: SlotArrays, worlds: np.ndarray, sort_by_distance: bool) -> None:
-        """The slots of every robot of ``worlds`` (indices) into ``out`` (clusters refreshed
-        first); ``out``'s last axis is the number of slots."""
+    def slots(
+        self,
+        out: SlotArrays,
+        worlds: np.ndarray,
+        sort_by_distance: bool,
+        packed: np.ndarray | None = None,
+    ) -> None:
+        """The slots of every robot of ``worlds`` (indices) into ``out`` and, packed, into
+        ``packed`` ``(N, K, n_slots, 10)`` if given (clusters refreshed first); ``out``'s last
+        axis is the number of slots."""
+        if packed is None:
+            packed = np.empty((*out.cluster.shape, len(SLOT_COLUMNS)))
         self.refresh_clusters()
         all_slots(
             worlds,
@@ -235,6 +244,7 @@ class Worlds:
             out.path_length,
             out.mask,
             out.live,
+            packed,
         )
 
     def explored_fraction(self, basis: str) -> np.ndarray:

@@ -74,6 +74,7 @@ class ExplorationMDP:
         self.source = EpisodeSource(cfg)
         self.world: World | None = None
         self._slot_arrays: SlotArrays | None = None
+        self._packed: np.ndarray | None = None  # the same slots, packed
         self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
@@ -229,6 +230,7 @@ class ExplorationMDP:
         assert self.world is not None
         sort = self.cfg.observation.sort_by_distance
         self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        self._packed = self.world.packed_slots()
         self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
@@ -245,6 +247,12 @@ class ExplorationMDP:
         buffers that the next step overwrites)."""
         assert self._slot_arrays is not None
         return self._slot_arrays
+
+    def packed_slots(self) -> np.ndarray:
+        """The robots' slots packed, ``(N, n_slots, 10)`` (a fresh copy of
+        :meth:`~frontier_marl.core.slots.SlotArrays.packed` of :meth:`slot_arrays`)."""
+        assert self._packed is not None
+        return self._packed.copy()
 
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
