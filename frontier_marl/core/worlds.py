@@ -21,7 +21,7 @@ from scipy import ndimage
 from frontier_marl.core.frontiers import (
     Clusters,
     cluster_worlds,
-    frontier_masks,
+    fill_frontier_masks,
     stacked_structure,
     unknown_around,
 )
@@ -86,6 +86,8 @@ class Worlds:
         self.gains = np.zeros((n, cells))
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
+        self._masks = np.zeros((n, height, width), dtype=bool)  # a recluster's buffers
+        self._labels = np.zeros((n, height, width), dtype=np.int32)
         self._structure = stacked_structure(params.connectivity)
         self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
 
@@ -166,8 +168,9 @@ class Worlds:
         if self.clustered_version.tobytes() == self.version.tobytes():  # the common case, fast
             return
         stale = np.flatnonzero(self.clustered_version != self.version)
-        masks = frontier_masks(self.belief, stale)
-        labels, _ = ndimage.label(masks, structure=self._structure)
+        masks, labels = self._masks[: len(stale)], self._labels[: len(stale)]
+        fill_frontier_masks(self.belief, stale, masks)
+        ndimage.label(masks, structure=self._structure, output=labels)
         cluster_worlds(
             labels,
             stale,

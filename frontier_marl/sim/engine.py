@@ -79,6 +79,10 @@ class ExplorationMDP:
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
         self.last: StepResult | None = None  # the latest step, None right after reset
+        obs = cfg.observation  # what the observations read, fixed by the config
+        self._heads = obs.features == "explorer" or obs.teammates == "positions+targets"
+        self._no_mates = obs.teammates == "none"
+        self._agents = range(cfg.n_agents)
         # The reward table's per-world inputs, (1,) arrays refilled every step.
         self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
@@ -267,10 +271,8 @@ class ExplorationMDP:
         after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        obs = self.cfg.observation
-        heads = obs.features == "explorer" or obs.teammates == "positions+targets"
-        heading = self._heading(targets, reached) if heads else None  # read by those alone
-        mates = self._teammate_table(positions, heading)
+        heading = self._heading(targets, reached) if self._heads else None  # read by those
+        mates = None if self._no_mates else self._teammate_table(positions, heading)
         motion = None if self._trail is None else self._trail.motion(0, positions)
         batch = self.encoder.encode_batch(
             self._slot_arrays,
@@ -281,8 +283,8 @@ class ExplorationMDP:
             self._beliefs(),
         )
         if isinstance(batch, dict):
-            agents = range(self.cfg.n_agents)
-            return [{key: value[agent] for key, value in batch.items()} for agent in agents]
+            items = batch.items()
+            return [{key: value[agent] for key, value in items} for agent in self._agents]
         return list(batch)
 
     def _beliefs(self) -> np.ndarray | None:
