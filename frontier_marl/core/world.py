@@ -73,6 +73,7 @@ class World:
         self._slots: SlotArrays | None = None  # the buffers of slot_arrays, made on first use
         self._slot_view: SlotArrays | None = None
         self._packed: np.ndarray | None = None
+        self._packed_view: np.ndarray | None = None
         self._make_views()
 
     def _make_views(self) -> None:
@@ -163,15 +164,16 @@ class World:
             self._slots = SlotArrays.empty(self._worlds.n_worlds, self.n_agents, n_slots)
             self._slot_view = self._slots.world(self._index)
             self._packed = np.empty((*self._slots.cluster.shape, len(SLOT_COLUMNS)))
+            self._packed_view = self._packed[self._index]
         self._worlds.slots(self._slots, self._index_array, sort_by_distance, self._packed)
         return self._slot_view
 
     def packed_slots(self) -> np.ndarray:
         """The slots of the last :meth:`slot_arrays` call packed, ``(K, n_slots, 10)``
         (:meth:`~frontier_marl.core.slots.SlotArrays.packed`), in a buffer it overwrites."""
-        if self._packed is None:
+        if self._packed_view is None:
             raise RuntimeError("packed_slots() comes after slot_arrays()")
-        return self._packed[self._index]
+        return self._packed_view
 
     def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""

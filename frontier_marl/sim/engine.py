@@ -75,6 +75,7 @@ class ExplorationMDP:
         self.world: World | None = None
         self._slot_arrays: SlotArrays | None = None
         self._packed: np.ndarray | None = None  # the same slots, packed
+        self._batch_slots: tuple[np.ndarray, ...] = ()  # live and target as a batch of one
         self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
@@ -149,14 +150,11 @@ class ExplorationMDP:
     # ------------------------------------------------------------------ helpers
     def _decide(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Targets (N, 2), padding and oscillation flags (N,) of the chosen ``slots``."""
-        arrays = self._slot_arrays
-        assert arrays is not None
         n = len(slots)
         targets = np.empty((n, 2), dtype=np.int64)
         padding, oscillation = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
         decide(
-            arrays.live[None],
-            arrays.target[None],
+            *self._batch_slots,
             slots[None],
             _ONE,
             self._oscillation.history,
@@ -191,7 +189,7 @@ class ExplorationMDP:
         reward = self.cfg.reward
         fraction = self.explored = self.world.explored_fraction(reward.threshold_basis)
         self._threshold[0] = fraction >= reward.explore_threshold
-        self._no_frontier[0] = np.count_nonzero(self._slot_arrays.live) == 0
+        self._no_frontier[0] = not np.count_nonzero(self._slot_arrays.live)
         self._steps[0], self._stalled[0] = self.steps, self.steps_without_progress
         outcome = batch_outcome(
             reward,
@@ -233,8 +231,10 @@ class ExplorationMDP:
     def _refresh_slots(self) -> None:
         assert self.world is not None
         sort = self.cfg.observation.sort_by_distance
-        self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
-        self._packed = self.world.packed_slots()
+        arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        if arrays is not self._slot_arrays:  # new buffers (a new world): new views of them
+            self._slot_arrays, self._packed = arrays, self.world.packed_slots()
+            self._batch_slots = (arrays.live[None], arrays.target[None])
         self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
