@@ -260,9 +260,15 @@ def cluster_stats(
 def frontier_masks(belief: np.ndarray, worlds: np.ndarray) -> np.ndarray:
     """(len(worlds), H, W) frontier masks of the given worlds."""
     out = np.zeros((len(worlds), belief.shape[1], belief.shape[2]), dtype=np.bool_)
+    fill_frontier_masks(belief, worlds, out)
+    return out
+
+
+@compiled
+def fill_frontier_masks(belief: np.ndarray, worlds: np.ndarray, out: np.ndarray) -> None:
+    """:func:`frontier_masks` into ``out`` (its first ``len(worlds)`` planes)."""
     for m in range(len(worlds)):
         out[m] = frontier_cells(belief[worlds[m]])[0]
-    return out
 
 
 @compiled

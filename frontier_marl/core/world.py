@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from frontier_marl.core.frontiers import Clusters
-from frontier_marl.core.slots import SlotArrays, SlotTable, robot_slots
+from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays, SlotTable, robot_slots
 from frontier_marl.core.worlds import FULL_PATH, WorldParams, Worlds
 
 __all__ = ["FULL_PATH", "MoveResult", "World", "WorldParams"]
@@ -72,6 +72,8 @@ class World:
         self._index_array = np.array([index])
         self._slots: SlotArrays | None = None  # the buffers of slot_arrays, made on first use
         self._slot_view: SlotArrays | None = None
+        self._packed: np.ndarray | None = None
+        self._packed_view: np.ndarray | None = None
         self._make_views()
 
     def _make_views(self) -> None:
@@ -161,8 +163,17 @@ class World:
         if self._slots is None or self._slots.cluster.shape[-1] != n_slots:
             self._slots = SlotArrays.empty(self._worlds.n_worlds, self.n_agents, n_slots)
             self._slot_view = self._slots.world(self._index)
-        self._worlds.slots(self._slots, self._index_array, sort_by_distance)
+            self._packed = np.empty((*self._slots.cluster.shape, len(SLOT_COLUMNS)))
+            self._packed_view = self._packed[self._index]
+        self._worlds.slots(self._slots, self._index_array, sort_by_distance, self._packed)
         return self._slot_view
+
+    def packed_slots(self) -> np.ndarray:
+        """The slots of the last :meth:`slot_arrays` call packed, ``(K, n_slots, 10)``
+        (:meth:`~frontier_marl.core.slots.SlotArrays.packed`), in a buffer it overwrites."""
+        if self._packed_view is None:
+            raise RuntimeError("packed_slots() comes after slot_arrays()")
+        return self._packed_view
 
     def slots(self, agent: int, n_slots: int, sort_by_distance: bool) -> SlotTable:
         """The cluster slots of robot ``agent`` (see :mod:`frontier_marl.core.slots`)."""

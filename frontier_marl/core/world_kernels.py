@@ -9,7 +9,7 @@ import numpy as np
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.movement import walk
-from frontier_marl.core.slots import _robot_slots
+from frontier_marl.core.slots import _pack, _robot_slots
 
 
 @compiled
@@ -99,9 +99,11 @@ def all_slots(
     path_length: np.ndarray,
     mask: np.ndarray,
     live: np.ndarray,
+    packed: np.ndarray,
 ) -> None:
     """:func:`~frontier_marl.core.slots._robot_slots` of every robot of ``worlds``, into the
-    outputs."""
+    outputs, and the same slots packed (:meth:`~frontier_marl.core.slots.SlotArrays.packed`)
+    into ``packed`` (N, K, S, 10)."""
     for n in worlds:
         cells, count = n_cells[n], n_clusters[n]
         for k in range(positions.shape[1]):
@@ -128,6 +130,7 @@ def all_slots(
             path_length[n, k] = result[7]
             mask[n, k] = result[8]
             live[n, k] = result[9]
+            _pack(*result[:5], result[7], result[5], result[6], packed[n, k])
 
 
 @compiled

@@ -21,14 +21,14 @@ from scipy import ndimage
 from frontier_marl.core.frontiers import (
     Clusters,
     cluster_worlds,
-    frontier_masks,
+    fill_frontier_masks,
     stacked_structure,
     unknown_around,
 )
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.sensing import Sensor, reveal
-from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays
 from frontier_marl.core.world_kernels import all_slots, count_known, settle_clusters, walk_worlds
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
@@ -86,6 +86,8 @@ class Worlds:
         self.gains = np.zeros((n, cells))
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
+        self._masks = np.zeros((n, height, width), dtype=bool)  # a recluster's buffers
+        self._labels = np.zeros((n, height, width), dtype=np.int32)
         self._structure = stacked_structure(params.connectivity)
         self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
 
@@ -166,8 +168,9 @@ class Worlds:
         if self.clustered_version.tobytes() == self.version.tobytes():  # the common case, fast
             return
         stale = np.flatnonzero(self.clustered_version != self.version)
-        masks = frontier_masks(self.belief, stale)
-        labels, _ = ndimage.label(masks, structure=self._structure)
+        masks, labels = self._masks[: len(stale)], self._labels[: len(stale)]
+        fill_frontier_masks(self.belief, stale, masks)
+        ndimage.label(masks, structure=self._structure, output=labels)
         cluster_worlds(
             labels,
             stale,
@@ -207,9 +210,18 @@ class Worlds:
             self.centroids[world, :count],
         )
 
-    def slots(self, out: SlotArrays, worlds: np.ndarray, sort_by_distance: bool) -> None:
-        """The slots of every robot of ``worlds`` (indices) into ``out`` (clusters refreshed
-        first); ``out``'s last axis is the number of slots."""
+    def slots(
+        self,
+        out: SlotArrays,
+        worlds: np.ndarray,
+        sort_by_distance: bool,
+        packed: np.ndarray | None = None,
+    ) -> None:
+        """The slots of every robot of ``worlds`` (indices) into ``out`` and, packed, into
+        ``packed`` ``(N, K, n_slots, 10)`` if given (clusters refreshed first); ``out``'s last
+        axis is the number of slots."""
+        if packed is None:
+            packed = np.empty((*out.cluster.shape, len(SLOT_COLUMNS)))
         self.refresh_clusters()
         all_slots(
             worlds,
@@ -235,6 +247,7 @@ class Worlds:
             out.path_length,
             out.mask,
             out.live,
+            packed,
         )
 
     def explored_fraction(self, basis: str) -> np.ndarray:

@@ -113,7 +113,7 @@ def build_infos(mdp: ExplorationMDP, result: StepResult | None, level: str) -> l
     else:
         targets = result.targets.copy()
         padding, oscillation = result.padding.tolist(), result.oscillation.tolist()
-    slots = mdp.slot_arrays().packed()
+    slots = mdp.packed_slots()
     for agent, info in enumerate(infos):
         info.update(
             slots=slots[agent],

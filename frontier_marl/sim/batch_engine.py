@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import SlotArrays, commit_to_previous
+from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.sim.decisions import decide, heading_of
 from frontier_marl.sim.episodes import EpisodeSource, world_params
@@ -47,6 +47,7 @@ class BatchMDP:
         self.source = EpisodeSource(cfg)
         self.rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(n)]
         self.slots = SlotArrays.empty(n, k, cfg.n_slots)
+        self.packed = np.empty((n, k, cfg.n_slots, len(SLOT_COLUMNS)))  # the slots, packed
         self._oscillation = OscillationHistory(n, k, cfg.reward.oscillation_window)
         self._trail = MotionTrail(n, k) if cfg.observation.turn else None
         self.steps = np.zeros(n, dtype=np.int64)
@@ -79,7 +80,7 @@ class BatchMDP:
         self.padding[worlds] = False
         self.oscillation[worlds] = False
         self.new_cells[worlds] = 0
-        self.worlds.slots(self.slots, worlds, self.cfg.observation.sort_by_distance)
+        self.worlds.slots(self.slots, worlds, self.cfg.observation.sort_by_distance, self.packed)
 
     # ------------------------------------------------------------------ transition
     def step(self, actions: np.ndarray, active: np.ndarray) -> None:
@@ -104,7 +105,7 @@ class BatchMDP:
         progress = new_cells.any(axis=1)
         self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + active)
         indices = self._all[active]
-        worlds.slots(slots, indices, self.cfg.observation.sort_by_distance)
+        worlds.slots(slots, indices, self.cfg.observation.sort_by_distance, self.packed)
         if self.cfg.observation.commit != "none":
             slots.mask[:] = commit_to_previous(
                 slots.mask,

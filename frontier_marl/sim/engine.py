@@ -74,10 +74,16 @@ class ExplorationMDP:
         self.source = EpisodeSource(cfg)
         self.world: World | None = None
         self._slot_arrays: SlotArrays | None = None
+        self._packed: np.ndarray | None = None  # the same slots, packed
+        self._batch_slots: tuple[np.ndarray, ...] = ()  # live and target as a batch of one
         self._tables: list[SlotTable] | None = None  # views of the arrays, made when asked
         self._oscillation = OscillationHistory(1, cfg.n_agents, cfg.reward.oscillation_window)
         self._trail = MotionTrail(1, cfg.n_agents) if cfg.observation.turn else None
         self.last: StepResult | None = None  # the latest step, None right after reset
+        obs = cfg.observation  # what the observations read, fixed by the config
+        self._heads = obs.features == "explorer" or obs.teammates == "positions+targets"
+        self._no_mates = obs.teammates == "none"
+        self._agents = range(cfg.n_agents)
         # The reward table's per-world inputs, (1,) arrays refilled every step.
         self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
@@ -144,14 +150,11 @@ class ExplorationMDP:
     # ------------------------------------------------------------------ helpers
     def _decide(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Targets (N, 2), padding and oscillation flags (N,) of the chosen ``slots``."""
-        arrays = self._slot_arrays
-        assert arrays is not None
         n = len(slots)
         targets = np.empty((n, 2), dtype=np.int64)
         padding, oscillation = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
         decide(
-            arrays.live[None],
-            arrays.target[None],
+            *self._batch_slots,
             slots[None],
             _ONE,
             self._oscillation.history,
@@ -186,7 +189,7 @@ class ExplorationMDP:
         reward = self.cfg.reward
         fraction = self.explored = self.world.explored_fraction(reward.threshold_basis)
         self._threshold[0] = fraction >= reward.explore_threshold
-        self._no_frontier[0] = np.count_nonzero(self._slot_arrays.live) == 0
+        self._no_frontier[0] = not np.count_nonzero(self._slot_arrays.live)
         self._steps[0], self._stalled[0] = self.steps, self.steps_without_progress
         outcome = batch_outcome(
             reward,
@@ -228,7 +231,10 @@ class ExplorationMDP:
     def _refresh_slots(self) -> None:
         assert self.world is not None
         sort = self.cfg.observation.sort_by_distance
-        self._slot_arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        arrays = self.world.slot_arrays(self.cfg.n_slots, sort)
+        if arrays is not self._slot_arrays:  # new buffers (a new world): new views of them
+            self._slot_arrays, self._packed = arrays, self.world.packed_slots()
+            self._batch_slots = (arrays.live[None], arrays.target[None])
         self._tables = None
 
     def slot_tables(self) -> list[SlotTable]:
@@ -246,6 +252,12 @@ class ExplorationMDP:
         assert self._slot_arrays is not None
         return self._slot_arrays
 
+    def packed_slots(self) -> np.ndarray:
+        """The robots' slots packed, ``(N, n_slots, 10)`` (a fresh copy of
+        :meth:`~frontier_marl.core.slots.SlotArrays.packed` of :meth:`slot_arrays`)."""
+        assert self._packed is not None
+        return self._packed.copy()
+
     def action_masks(self) -> list[np.ndarray]:
         """Per robot, int8 mask of valid slots; with no live slot, slot 0 (idle) is valid."""
         assert self._slot_arrays is not None
@@ -259,10 +271,8 @@ class ExplorationMDP:
         after reset) give the teammates' current targets."""
         assert self.world is not None
         positions = self.world.positions
-        obs = self.cfg.observation
-        heads = obs.features == "explorer" or obs.teammates == "positions+targets"
-        heading = self._heading(targets, reached) if heads else None  # read by those alone
-        mates = self._teammate_table(positions, heading)
+        heading = self._heading(targets, reached) if self._heads else None  # read by those
+        mates = None if self._no_mates else self._teammate_table(positions, heading)
         motion = None if self._trail is None else self._trail.motion(0, positions)
         batch = self.encoder.encode_batch(
             self._slot_arrays,
@@ -273,8 +283,8 @@ class ExplorationMDP:
             self._beliefs(),
         )
         if isinstance(batch, dict):
-            agents = range(self.cfg.n_agents)
-            return [{key: value[agent] for key, value in batch.items()} for agent in agents]
+            items = batch.items()
+            return [{key: value[agent] for key, value in items} for agent in self._agents]
         return list(batch)
 
     def _beliefs(self) -> np.ndarray | None:

@@ -176,13 +176,13 @@ def batch_outcome(
     out: BatchOutcome | None = None,
 ) -> BatchOutcome:
     """Apply the reward table to one step of W worlds of N robots: per-robot arrays are
-    ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched);
+    ``(W, N)``, per-world ones ``(W,)`` (the fields of :class:`StepEvents`, batched; numpy
+    arrays of integers or bools, as they come: converting them cost more than the table);
     ``moved`` (cells walked) is needed by the ``travel`` reward only. The outcome is written
     into ``out`` when given (arrays of those shapes), into fresh arrays otherwise."""
     constants, travel, padding_truncates, no_progress_limit, max_steps = _constants(cfg)
     if travel and moved is None:
         raise ValueError("the travel reward needs the cells each robot walked")
-    new_cells = np.asarray(new_cells, dtype=np.int64)
     worlds, robots = new_cells.shape
     outcome = out or BatchOutcome(
         np.empty((worlds, robots)),
@@ -197,13 +197,13 @@ def batch_outcome(
         no_progress_limit,
         max_steps,
         new_cells,
-        np.asarray(padding, dtype=np.bool_),
-        np.asarray(oscillation, dtype=np.bool_),
-        np.asarray(threshold_reached, dtype=np.bool_),
-        np.asarray(no_frontier_left, dtype=np.bool_),
-        np.asarray(steps_taken, dtype=np.int64),
-        np.asarray(steps_without_progress, dtype=np.int64),
-        new_cells if moved is None else np.asarray(moved, dtype=np.int64),  # read by travel only
+        padding,
+        oscillation,
+        threshold_reached,
+        no_frontier_left,
+        steps_taken,
+        steps_without_progress,
+        new_cells if moved is None else moved,  # read by the travel reward only
         outcome.rewards,
         outcome.terminated,
         outcome.truncated,
