@@ -89,6 +89,44 @@ def _spearman(predicted: torch.Tensor, data: Decisions) -> float:
     return float(np.mean(values)) if values else float("nan")
 
 
+def _decisions(
+    model: Any, names: list[str], label_episodes: int, weights: list[float]
+) -> dict[str, Any]:
+    """Each family's decision report on labelled validation episodes, printed."""
+    labels = validation_labels(names, label_episodes)
+    decisions = {
+        name: decision_report(model, group(samples, 12), weights)
+        for name, samples in labels.items()
+    }
+    for name, part in decisions.items():
+        print(f"{name}: {part['decisions']} decisions, spearman {part['spearman']:.3f}")
+        for label, row in part["choosers"].items():
+            print(f"  {label:<26} cheapest {row['cheapest']:.1%}  regret {row['regret']:.4f}")
+    return decisions
+
+
+def _benchmark_rows(
+    model: Any, names: list[str], weights: list[float], episodes: int, progress: bool
+) -> list[dict[str, Any]]:
+    """The scorer at each rule weight beside frontier-rule on validation episodes."""
+    contenders = [heuristic("frontier-rule")] + [
+        Contender(
+            f"scorer-w{w:g}",
+            False,
+            lambda w=w: MapExplorer(model, f"scorer-w{w:g}", w),
+            scorer_config,
+        )
+        for w in weights
+    ]
+    return run_benchmark(
+        [family(name) for name in names],
+        contenders,
+        episodes,
+        progress=progress,
+        split="validation",
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("model", type=Path, help="a saved map scorer's folder")
@@ -107,32 +145,9 @@ def main(argv: list[str] | None = None) -> int:
     names = args.families.split(",")
     report: dict[str, Any] = {"options": {k: str(v) for k, v in vars(args).items()}}
     if args.label_episodes:
-        labels = validation_labels(names, args.label_episodes)
-        report["decisions"] = {
-            name: decision_report(model, group(samples, 12), weights)
-            for name, samples in labels.items()
-        }
-        for name, part in report["decisions"].items():
-            print(f"{name}: {part['decisions']} decisions, spearman {part['spearman']:.3f}")
-            for label, row in part["choosers"].items():
-                print(f"  {label:<26} cheapest {row['cheapest']:.1%}  regret {row['regret']:.4f}")
+        report["decisions"] = _decisions(model, names, args.label_episodes, weights)
     if args.episodes:
-        contenders = [heuristic("frontier-rule")] + [
-            Contender(
-                f"scorer-w{w:g}",
-                False,
-                lambda w=w: MapExplorer(model, f"scorer-w{w:g}", w),
-                scorer_config,
-            )
-            for w in weights
-        ]
-        rows = run_benchmark(
-            [family(name) for name in names],
-            contenders,
-            args.episodes,
-            progress=not args.no_progress,
-            split="validation",
-        )
+        rows = _benchmark_rows(model, names, weights, args.episodes, not args.no_progress)
         report["rows"] = rows
         print(format_table(rows))
     if args.json is not None:

@@ -20,9 +20,11 @@ import json
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import EnvConfig
 from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
@@ -59,6 +61,19 @@ def parse_list(text: str, kind: type, what: str, parser: argparse.ArgumentParser
         parser.error(f"{what} must be comma-separated numbers, got {text!r}")
 
 
+def _family_row(
+    family: str, cfg: EnvConfig, seeds: list[int], variants: dict[str, tuple[int, float]]
+) -> dict[str, Any]:
+    """Each variant's mean T99 relative to the path-only scorer on ``family``'s episodes."""
+    names = feature_names(cfg)
+    reference, _ = play_scorer(cfg, seeds, scorer(names, 0, 0.0, {"path": -1.0}))
+    row: dict[str, Any] = {"family": family}
+    for label, (radius, weight) in variants.items():
+        t99, _ = play_scorer(cfg, seeds, scorer(names, radius, weight))
+        row[label] = float(relative_t99(t99, reference).mean())
+    return row
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--radii", default="4,8,12,16,20", help="half-sides R, in cells")
@@ -77,12 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
-        names = feature_names(cfg)
-        reference, _ = play_scorer(cfg, seeds, scorer(names, 0, 0.0, {"path": -1.0}))
-        row = {"family": family}
-        for label, (radius, weight) in variants.items():
-            t99, _ = play_scorer(cfg, seeds, scorer(names, radius, weight))
-            row[label] = float(relative_t99(t99, reference).mean())
+        row = _family_row(family, cfg, seeds, variants)
         rows.append(row)
         cells = "  ".join(
             f"{label} {100 * value:+.2f}" for label, value in row.items() if label != "family"

@@ -23,6 +23,7 @@ import argparse
 import json
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from frontier_marl.evaluation.benchmark.families import VALIDATION_SEEDS, family
 from frontier_marl.evaluation.benchmark.run import contenders, run_benchmark
@@ -52,7 +53,8 @@ def benchmark_at(scale: int, layouts: str, policies: str, episodes: int, first: 
     )
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[int]]:
+    """The options, with the checked scales."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scales", default="1,2,3,4,6", help="comma-separated scales K")
     parser.add_argument("--layouts", choices=sorted(LAYOUTS), default="rooms")
@@ -67,22 +69,30 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--scales must be comma-separated integers, got {args.scales!r}")
     if not VALIDATION_SEEDS.start <= args.first < VALIDATION_SEEDS.stop:
         parser.error(f"--first must be a validation seed, in {VALIDATION_SEEDS}")
+    return args, scales
+
+
+def _summary_row(scale: int, layouts: str, row: dict[str, Any]) -> dict[str, Any]:
+    """One policy's benchmark row at ``scale``, in brief."""
+    best = row.get("vs_best") or {}
+    return {
+        "scale": scale,
+        "perception_range": sensor_range(scale, layouts),
+        "policy": row["policy"],
+        "success": row["success"],
+        "t99_mean": row["t99_mean"],
+        "vs_best_mean": best.get("mean"),
+        "vs_best_ci": [best["ci_low"], best["ci_high"]] if best else None,
+        "best_heuristic": row["best_heuristic"],
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    args, scales = _parse_args(argv)
     summary = []
     for scale in scales:
         for row in benchmark_at(scale, args.layouts, args.policies, args.episodes, args.first):
-            best = row.get("vs_best") or {}
-            summary.append(
-                {
-                    "scale": scale,
-                    "perception_range": sensor_range(scale, args.layouts),
-                    "policy": row["policy"],
-                    "success": row["success"],
-                    "t99_mean": row["t99_mean"],
-                    "vs_best_mean": best.get("mean"),
-                    "vs_best_ci": [best["ci_low"], best["ci_high"]] if best else None,
-                    "best_heuristic": row["best_heuristic"],
-                }
-            )
+            summary.append(_summary_row(scale, args.layouts, row))
         mine = [row for row in summary if row["scale"] == scale]
         cells = ", ".join(f"{row['policy']} {row['t99_mean']:.1f}" for row in mine)
         print(f"K = {scale}: {cells}", flush=True)

@@ -234,29 +234,22 @@ class NullVecEnv:
         return _Null()
 
 
-def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict[str, Any]:
-    """Train ``algorithm`` on the batched env and on a null env with the same spaces, in
-    alternating chunks of one run each; the env's share of the wall time."""
-    import torch
+def _model(algorithm: str, env: Any) -> Any:
+    """DQN with the thesis's hyperparameters, or PPO, on ``env``."""
     from stable_baselines3 import DQN, PPO
 
-    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+    if algorithm == "dqn":
+        return DQN(
+            "MultiInputPolicy", env, learning_rate=5e-5, exploration_fraction=0.7,
+            exploration_final_eps=0.05, batch_size=64, buffer_size=50_000,
+            target_update_interval=500, train_freq=4, learning_starts=1000, seed=0,
+        )  # fmt: skip
+    return PPO("MultiInputPolicy", env, n_steps=128, batch_size=256, n_epochs=4, seed=0)
 
-    torch.set_num_threads(1)
-    real = make_batched_vec_env({"config": make_config(**CONFIG01)}, n_envs, seed=0)
-    envs = {"null": NullVecEnv(real), "env": real}
-    models = {}
-    for name, env in envs.items():
-        if algorithm == "dqn":  # the thesis's hyperparameters
-            models[name] = DQN(
-                "MultiInputPolicy", env, learning_rate=5e-5, exploration_fraction=0.7,
-                exploration_final_eps=0.05, batch_size=64, buffer_size=50_000,
-                target_update_interval=500, train_freq=4, learning_starts=1000, seed=0,
-            )  # fmt: skip
-        else:
-            models[name] = PPO(
-                "MultiInputPolicy", env, n_steps=128, batch_size=256, n_epochs=4, seed=0
-            )
+
+def _chunk_seconds(models: dict[str, Any], steps: int, chunks: int) -> dict[str, list[float]]:
+    """Train the models in alternating chunks (the order flips every chunk); each chunk's
+    wall time per model."""
     seconds: dict[str, list[float]] = {name: [] for name in models}
     per_chunk = -(-steps // chunks)
     for chunk in range(chunks):
@@ -265,6 +258,21 @@ def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict
             start = time.perf_counter()
             models[name].learn(per_chunk, reset_num_timesteps=chunk == 0)
             seconds[name].append(time.perf_counter() - start)
+    return seconds
+
+
+def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict[str, Any]:
+    """Train ``algorithm`` on the batched env and on a null env with the same spaces, in
+    alternating chunks of one run each; the env's share of the wall time."""
+    import torch
+
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+
+    torch.set_num_threads(1)
+    real = make_batched_vec_env({"config": make_config(**CONFIG01)}, n_envs, seed=0)
+    envs = {"null": NullVecEnv(real), "env": real}
+    models = {name: _model(algorithm, env) for name, env in envs.items()}
+    seconds = _chunk_seconds(models, steps, chunks)
     total = {name: sum(values) for name, values in seconds.items()}
     by_chunk = np.array([(e - n) / e for n, e in zip(seconds["null"], seconds["env"], strict=True)])
     return {
