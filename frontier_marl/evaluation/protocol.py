@@ -219,22 +219,9 @@ def evaluate(
             ``None`` runs until the env ends the episode.
         on_episode: called with ``(i, record)`` after each episode (e.g. a progress bar).
     """
-    if isinstance(episodes, bool) or not isinstance(episodes, numbers.Integral) or episodes < 1:
-        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
-    episodes, seed = int(episodes), int(seed)
-    if map_mode is not None:
-        if map_mode not in ("static", "dynamic"):
-            raise ValueError(f"map_mode must be 'static' or 'dynamic', got {map_mode!r}")
-        if not isinstance(env, Mapping):
-            raise ValueError("map_mode= needs env kwargs; set it on the env you pass instead")
-        env = {**env, "map_mode": map_mode}
-    for level in coverage_levels:
-        if not 0.0 < level <= 1.0:
-            raise ValueError(f"coverage_levels must lie in (0, 1], got {level!r}")
-    if max_steps is not None and max_steps < 1:
-        raise ValueError(f"max_steps must be >= 1 or None, got {max_steps!r}")
+    episodes, seed = _checked_counts(episodes, seed)
+    env = _with_map_mode(env, map_mode)
+    _check_limits(coverage_levels, max_steps)
     instance, owned = _build_env(env)
     try:
         view = _TeamView(instance)
@@ -249,8 +236,7 @@ def evaluate(
         if owned:
             instance.close()
     config = _config_of(instance)
-    config_dict = None
-    map_mode = map_seed = None
+    config_dict = map_mode = map_seed = None
     if config is not None:
         from frontier_marl.config import config_to_dict
 
@@ -268,3 +254,31 @@ def evaluate(
         map_mode=map_mode,
         map_seed=map_seed,
     )
+
+
+def _checked_counts(episodes: Any, seed: Any) -> tuple[int, int]:
+    """``episodes`` (>= 1) and ``seed`` (>= 0) as ints, or a ValueError naming the bad one."""
+    if isinstance(episodes, bool) or not isinstance(episodes, numbers.Integral) or episodes < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
+    return int(episodes), int(seed)
+
+
+def _with_map_mode(env: EnvSpec, map_mode: str | None) -> EnvSpec:
+    """``env`` with ``map_mode`` merged in (env kwargs only)."""
+    if map_mode is None:
+        return env
+    if map_mode not in ("static", "dynamic"):
+        raise ValueError(f"map_mode must be 'static' or 'dynamic', got {map_mode!r}")
+    if not isinstance(env, Mapping):
+        raise ValueError("map_mode= needs env kwargs; set it on the env you pass instead")
+    return {**env, "map_mode": map_mode}
+
+
+def _check_limits(coverage_levels: Sequence[float], max_steps: int | None) -> None:
+    for level in coverage_levels:
+        if not 0.0 < level <= 1.0:
+            raise ValueError(f"coverage_levels must lie in (0, 1], got {level!r}")
+    if max_steps is not None and max_steps < 1:
+        raise ValueError(f"max_steps must be >= 1 or None, got {max_steps!r}")
