@@ -42,47 +42,8 @@ def plot_baselines(
     bars, curves = axes[0], axes[1]
     try:
         names = [str(row["policy"]) for row in rows]
-        x = np.arange(len(rows))
-        means = [float(row["mean_reward"]) for row in rows]
-        stds = [float(row["std_reward"]) for row in rows]
-        has_thesis = any(row.get("thesis_mean") is not None for row in rows)
-        width = 0.38 if has_thesis else 0.6
-        offset = width / 2 if has_thesis else 0.0
         colours = [f"C{i}" for i in range(len(rows))]
-        bars.bar(x - offset, means, width, yerr=stds, capsize=4, color=colours, label="ours")
-        if has_thesis:
-            known = [i for i, row in enumerate(rows) if row.get("thesis_mean") is not None]
-            t_x = [i + offset for i in known]
-            t_mean = [float(rows[i]["thesis_mean"]) for i in known]
-            t_std = [float(rows[i].get("thesis_std") or 0.0) for i in known]
-            bars.bar(
-                t_x,
-                t_mean,
-                width,
-                yerr=t_std,
-                capsize=4,
-                color="0.75",
-                edgecolor="0.3",
-                hatch="//",
-                label="thesis",
-            )
-            bars.legend(loc="best", fontsize=8)
-        for i, row in enumerate(rows):
-            bars.annotate(
-                f"{row['terminations']}/{row['episodes']}",
-                (i - offset, 0.0),
-                textcoords="offset points",
-                xytext=(0, 3 if means[i] >= 0 else -3),
-                ha="center",
-                va="bottom" if means[i] >= 0 else "top",
-                fontsize=7,
-                color="white" if abs(means[i]) > 1.0 else "black",
-            )
-        bars.set_xticks(x, names, rotation=15)
-        bars.set_ylabel("total episode reward (mean ± std)")
-        bars.axhline(0.0, color="0.5", linewidth=0.8)
-        bars.set_title("total reward (in bar: episodes reaching the threshold)", fontsize=9)
-
+        _reward_panel(bars, rows, names, colours)
         _coverage_panel(curves, rows, "curve", colours, names)
         curves.set_xlabel("cells travelled (team total)")
         curves.set_title("coverage vs travel (mean ± std over episodes)", fontsize=9)
@@ -96,6 +57,56 @@ def plot_baselines(
         fig.savefig(os.fspath(path), dpi=110)
     finally:
         plt.close(fig)
+
+
+def _reward_panel(
+    bars: Any, rows: Sequence[Mapping[str, Any]], names: list[str], colours: list[str]
+) -> None:
+    """Mean total reward per policy (± std), the thesis's figure beside it where known, and
+    each bar's count of episodes that reached the threshold."""
+    x = np.arange(len(rows))
+    means = [float(row["mean_reward"]) for row in rows]
+    stds = [float(row["std_reward"]) for row in rows]
+    has_thesis = any(row.get("thesis_mean") is not None for row in rows)
+    width = 0.38 if has_thesis else 0.6
+    offset = width / 2 if has_thesis else 0.0
+    bars.bar(x - offset, means, width, yerr=stds, capsize=4, color=colours, label="ours")
+    if has_thesis:
+        _thesis_bars(bars, rows, width, offset)
+    for i, row in enumerate(rows):
+        bars.annotate(
+            f"{row['terminations']}/{row['episodes']}",
+            (i - offset, 0.0),
+            textcoords="offset points",
+            xytext=(0, 3 if means[i] >= 0 else -3),
+            ha="center",
+            va="bottom" if means[i] >= 0 else "top",
+            fontsize=7,
+            color="white" if abs(means[i]) > 1.0 else "black",
+        )
+    bars.set_xticks(x, names, rotation=15)
+    bars.set_ylabel("total episode reward (mean ± std)")
+    bars.axhline(0.0, color="0.5", linewidth=0.8)
+    bars.set_title("total reward (in bar: episodes reaching the threshold)", fontsize=9)
+
+
+def _thesis_bars(bars: Any, rows: Sequence[Mapping[str, Any]], width: float, offset: float) -> None:
+    known = [i for i, row in enumerate(rows) if row.get("thesis_mean") is not None]
+    t_x = [i + offset for i in known]
+    t_mean = [float(rows[i]["thesis_mean"]) for i in known]
+    t_std = [float(rows[i].get("thesis_std") or 0.0) for i in known]
+    bars.bar(
+        t_x,
+        t_mean,
+        width,
+        yerr=t_std,
+        capsize=4,
+        color="0.75",
+        edgecolor="0.3",
+        hatch="//",
+        label="thesis",
+    )
+    bars.legend(loc="best", fontsize=8)
 
 
 def _episode_curves(row: Mapping[str, Any], key: str) -> list[np.ndarray]:
