@@ -19,6 +19,8 @@ thesis-20x20 with one robot and random valid actions:
 
 The report gives each figure's median and minimum over the rounds per tree and the ratio of
 the medians (``--dqn-steps 0`` leaves the training share out, for quick step timings).
+``--vector-envs N`` also times ``vector_env(N)`` per decision (CPU time) in the trees that have
+it, and reports it against the before tree's single parallel env.
 """
 
 from __future__ import annotations
@@ -113,6 +115,29 @@ def parallel_step_us(steps: int) -> tuple[float, float]:
     return 1e6 * elapsed / steps, 1e6 * cpu / steps
 
 
+def vector_cpu_us(num_envs: int, steps: int) -> float | None:
+    """CPU microseconds per decision of ``frontier_marl.vector_env(num_envs)`` (mask infos,
+    random valid slots, thesis-20x20), or None in a tree without it."""
+    import numpy as np
+
+    import frontier_marl
+
+    if not hasattr(frontier_marl, "vector_env"):
+        return None
+    env = frontier_marl.vector_env(num_envs, preset="thesis-20x20", info="mask")
+    rng = np.random.default_rng(0)
+    _, infos = env.reset(seed=0)
+    cpu = 0.0
+    for step in range(steps + 20):  # the first 20 warm up
+        masks = infos["action_mask"]
+        actions = (rng.random(masks.shape) * masks).argmax(axis=1)
+        start = time.thread_time()
+        _, _, _, _, infos = env.step(actions)
+        if step >= 20:
+            cpu += time.thread_time() - start
+    return 1e6 * cpu / (steps * num_envs)
+
+
 def checkout_module(path: Path) -> ModuleType:
     """The module in ``path``, loaded from its file: the worker's ``frontier_marl`` is the tree
     under test (``PYTHONPATH``), which may predate the module, and every tree is measured by
@@ -142,6 +167,8 @@ def worker(args: argparse.Namespace) -> None:
         ("parallel_step_us", parallel_step_us(args.steps)),
     ):
         report[name], report[name.replace("_us", "_cpu_us")] = wall, cpu
+    if args.vector_envs > 0:
+        report["vector_cpu_us"] = vector_cpu_us(args.vector_envs, max(args.steps // 64, 10))
     if args.dqn_steps > 0:
         report["env_share"] = env_share(args.dqn_steps, args.dqn_chunks)
     print(json.dumps(report))
@@ -151,6 +178,7 @@ def measure(tree: Path, args: argparse.Namespace) -> dict[str, Any]:
     env = {**os.environ, "PYTHONPATH": str(tree)}
     command = [sys.executable, __file__, "--worker", "--steps", str(args.steps)]
     command += ["--dqn-steps", str(args.dqn_steps), "--dqn-chunks", str(args.dqn_chunks)]
+    command += ["--vector-envs", str(args.vector_envs)]
     done = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
     report = json.loads(done.stdout.strip().splitlines()[-1])
     if not Path(report["package"]).is_relative_to(tree):
@@ -166,6 +194,9 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=20_000, help="timed env steps")
     parser.add_argument("--dqn-steps", type=int, default=30_000)
     parser.add_argument("--dqn-chunks", type=int, default=10)
+    parser.add_argument(
+        "--vector-envs", type=int, default=0, help="also time vector_env(N) (0: not)"
+    )
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -206,6 +237,15 @@ def main() -> None:
             f"{k:<22} median before {before['median']:8.3f} after {after['median']:8.3f} "
             f"(ratio {after['median'] / before['median']:.3f}); min before {before['min']:8.3f} "
             f"after {after['min']:8.3f}"
+        )
+    vector = [r["vector_cpu_us"] for r in runs["after"] if r.get("vector_cpu_us") is not None]
+    if vector:  # the batched env against the older tree's single env, per decision
+        single = statistics.median(r["parallel_step_cpu_us"] for r in runs["before"])
+        per_decision = statistics.median(vector)
+        report["vector_speedup_over_before_single"] = single / per_decision
+        print(
+            f"vector_env({args.vector_envs}) CPU us per decision, median {per_decision:.3f}: "
+            f"{single / per_decision:.1f}x the before tree's single parallel env"
         )
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=1) + "\n")
