@@ -25,4 +25,12 @@ def test_comparing_the_checkout_with_itself(tmp_path: Path) -> None:
         for row in rows:
             assert Path(row["package"]).is_relative_to(REPO)
             assert row["step_us"] > 0 and row["step_us_training"] > 0
-    assert set(report["median_ratio_after_before"]) == {"step_us", "step_us_training"}
+            assert row["parallel_step_us"] > 0 and row["parallel_step_cpu_us"] > 0
+    assert set(report["median_ratio_after_before"]) == {
+        "step_us",
+        "step_cpu_us",
+        "step_us_training",
+        "step_cpu_us_training",
+        "parallel_step_us",
+        "parallel_step_cpu_us",
+    }

@@ -153,7 +153,10 @@ class FrontierParallelEnv(ParallelEnv):
                 f"missing {missing}, unexpected {extra}"
             )
         result = self._mdp.step([actions[agent] for agent in agents])
-        observations = dict(zip(agents, map(self.layout.wrap, result.observations), strict=True))
+        observed = result.observations
+        if self.layout.classic:  # the flat layout is the engine's own
+            observed = list(map(self.layout.wrap, observed))
+        observations = dict(zip(agents, observed, strict=True))
         rewards = dict(zip(agents, result.rewards.tolist(), strict=True))
         terminations = dict.fromkeys(agents, result.terminated)
         truncations = dict.fromkeys(agents, result.truncated)

@@ -87,7 +87,9 @@ class ExplorationMDP:
         # The reward table's per-world inputs, (1,) arrays refilled every step.
         self._threshold, self._no_frontier = np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
         self._steps, self._stalled = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
-        self._ends = (np.zeros(1, bool), np.zeros(1, bool), np.zeros(1, np.int64))  # its flags
+        self._ends = BatchOutcome(  # its outputs: fresh rewards each step, the rest reused
+            np.zeros((1, cfg.n_agents)), np.zeros(1, bool), np.zeros(1, bool), np.zeros(1, np.int64)
+        )
         self.steps = 0
         self.steps_without_progress = 0
         self.explored = 0.0  # the explored fraction on the threshold's basis, now
@@ -121,7 +123,8 @@ class ExplorationMDP:
             [self._check_action(action, agent) for agent, action in enumerate(actions)],
             dtype=np.int64,
         )
-        targets, padding, oscillation = self._decide(slots)
+        chosen = self._decide(slots)
+        targets, padding, oscillation = chosen[0][0], chosen[1][0], chosen[2][0]
         world = self.world
         before = world.travelled.copy() if cfg.reward.kind == "travel" else None
         if self._trail is not None:
@@ -135,7 +138,7 @@ class ExplorationMDP:
         if cfg.observation.commit != "none":
             self._commit(targets, new_cells)
         travel = None if before is None else world.travelled - before
-        outcome = self._outcome(new_cells, padding, oscillation, travel)
+        outcome = self._outcome(new_cells, chosen[1], chosen[2], travel)
         self.done = outcome.terminated or outcome.truncated
         self.last = StepResult(
             self._observations(targets, moved.reached),
@@ -149,19 +152,13 @@ class ExplorationMDP:
 
     # ------------------------------------------------------------------ helpers
     def _decide(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Targets (N, 2), padding and oscillation flags (N,) of the chosen ``slots``."""
+        """Targets (1, N, 2), padding and oscillation flags (1, N) of the chosen ``slots``
+        (fresh arrays, a batch of one world)."""
         n = len(slots)
-        targets = np.empty((n, 2), dtype=np.int64)
-        padding, oscillation = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
-        decide(
-            *self._batch_slots,
-            slots[None],
-            _ONE,
-            self._oscillation.history,
-            targets[None],
-            padding[None],
-            oscillation[None],
-        )
+        targets = np.empty((1, n, 2), dtype=np.int64)
+        padding, oscillation = np.empty((1, n), dtype=bool), np.empty((1, n), dtype=bool)
+        history = self._oscillation.history
+        decide(*self._batch_slots, slots[None], _ONE, history, targets, padding, oscillation)
         return targets, padding, oscillation
 
     def _commit(self, targets: np.ndarray, new_cells: np.ndarray) -> None:
@@ -184,24 +181,26 @@ class ExplorationMDP:
         oscillation: np.ndarray,
         travel: np.ndarray | None,
     ) -> StepOutcome:
-        """The reward table on this step (one world's scalars in persistent arrays)."""
+        """The reward table on this step: ``padding`` and ``oscillation`` (1, N) as
+        :meth:`_decide` gives them, the world's scalars in persistent arrays."""
         assert self.world is not None and self._slot_arrays is not None
         reward = self.cfg.reward
         fraction = self.explored = self.world.explored_fraction(reward.threshold_basis)
         self._threshold[0] = fraction >= reward.explore_threshold
         self._no_frontier[0] = not np.count_nonzero(self._slot_arrays.live)
         self._steps[0], self._stalled[0] = self.steps, self.steps_without_progress
+        self._ends.rewards = np.empty((1, len(new_cells)))  # fresh: the result holds them
         outcome = batch_outcome(
             reward,
             new_cells[None],
-            padding[None],
-            oscillation[None],
+            padding,
+            oscillation,
             self._threshold,
             self._no_frontier,
             self._steps,
             self._stalled,
             None if travel is None else travel[None],
-            BatchOutcome(np.empty((1, len(new_cells))), *self._ends),  # fresh rewards
+            self._ends,
         )
         return first_outcome(outcome)
 
