@@ -11,11 +11,19 @@ import pytest
 torch = pytest.importorskip("torch")
 
 from frontier_marl.cli.main import main  # noqa: E402
+from frontier_marl.config import make_config  # noqa: E402
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN  # noqa: E402
 from frontier_marl.evaluation.benchmark import families as map_families  # noqa: E402
+from frontier_marl.evaluation.benchmark.contenders import map_model  # noqa: E402
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
-from frontier_marl.policies.map_explorer import MapExplorer, load_scorer, new_scorer  # noqa: E402
+from frontier_marl.policies.linear_scorer import feature_names  # noqa: E402
+from frontier_marl.policies.map_explorer import (  # noqa: E402
+    MapExplorer,
+    load_scorer,
+    new_scorer,
+    save_map_explorer,
+)
 from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
 from frontier_marl.training.cost_regression import scorer_config  # noqa: E402
 from frontier_marl.training.cost_to_go import (  # noqa: E402
@@ -147,26 +155,22 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     assert [r["policy"] for r in rows] == ["frontier-rule", "best"] and rows[1]["success"] == 1
     assert rows[1]["config"]["n_slots"] == 12  # frontier-rule's slots
     probe_json = tmp_path / "probe.json"
-    probe_args = ["--families", "random-20", "--episodes", "1", "--label-episodes", "1"]
-    assert (
-        probe_main(
-            [
-                str(out / "best"),
-                "--weights",
-                "0,1",
-                *probe_args,
-                "--no-progress",
-                "--json",
-                str(probe_json),
-            ]
-        )
-        == 0
-    )
+    probe_args = ["--weights", "0,1", "--families", "random-20", "--episodes", "1"]
+    probe_args += ["--label-episodes", "1", "--no-progress", "--json", str(probe_json)]
+    assert probe_main([str(out / "best"), *probe_args]) == 0
     probe = json.loads(probe_json.read_text())
     choosers = probe["decisions"]["random-20"]["choosers"]
     assert {"scorer (rule weight 0)", "scorer (rule weight 1)", "frontier-rule"} <= set(choosers)
     assert all(0 <= c["cheapest"] <= 1 and c["regret"] >= 0 for c in choosers.values())
     assert [r["policy"] for r in probe["rows"]] == ["frontier-rule", "scorer-w0", "scorer-w1"]
+
+
+def test_the_benchmark_plays_a_saved_scorer_with_its_saved_rule_weight(tmp_path: Path) -> None:
+    model = new_scorer(len(feature_names(scorer_config(make_config("thesis-20x20")))))
+    save_map_explorer(model, tmp_path / "scorer", {"rule_weight": 0.5})
+    policy = map_model(tmp_path / "scorer", "scorer").make()
+    assert isinstance(policy, MapExplorer) and policy.rule_weight == 0.5
+    assert MapExplorer.load(tmp_path / "scorer").rule_weight == 0.5
 
 
 def test_the_explorer_acts_on_valid_slots_only() -> None:

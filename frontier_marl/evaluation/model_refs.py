@@ -42,9 +42,9 @@ def cached_model(source: str) -> LoadedModel:
     return _cached("sb3", resolve_model_path(source), partial(load_model, source))
 
 
-def cached_scorer(folder: str) -> Any:
-    """The map scorer saved in ``folder``, once per process (ValueError naming the extra
-    when torch is missing)."""
+def cached_scorer(folder: str) -> tuple[Any, dict[str, Any]]:
+    """The map scorer saved in ``folder`` and its metadata, once per process (ValueError
+    naming the extra when torch is missing)."""
     try:  # torch is the train extra's
         from frontier_marl.policies.map_explorer import load_scorer
     except ModuleNotFoundError as exc:
@@ -53,7 +53,7 @@ def cached_scorer(folder: str) -> Any:
             "pip install 'frontier-marl[train]'"
         ) from None
     path = Path(folder)
-    return _cached("scorer", path / MAP_SCORER_FILE, lambda: load_scorer(path)[0])
+    return _cached("scorer", path / MAP_SCORER_FILE, lambda: load_scorer(path))
 
 
 def source_of(name: str | Path) -> str:

@@ -101,7 +101,8 @@ class ModelWorld:
 
 @dataclass(frozen=True)
 class ScorerMaker:
-    """``make`` of a saved map scorer: a :class:`MapExplorer` labelled ``label``."""
+    """``make`` of a saved map scorer: a :class:`MapExplorer` labelled ``label``, with the
+    weight of frontier-rule's margin its training chose (``rule_weight`` in its metadata)."""
 
     folder: str
     label: str
@@ -109,7 +110,8 @@ class ScorerMaker:
     def __call__(self) -> Any:
         from frontier_marl.policies.map_explorer import MapExplorer  # torch: loaded_scorer's
 
-        return MapExplorer(cached_scorer(self.folder), self.label)
+        model, metadata = cached_scorer(self.folder)
+        return MapExplorer(model, self.label, float(metadata.get("rule_weight", 0.0)))
 
 
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
