@@ -64,9 +64,7 @@ def branch(source: Worlds, index: int, count: int, gain: str | None = None) -> W
     return sims
 
 
-def branch_mdp(
-    mdp: ExplorationMDP, count: int, rng: np.random.Generator | None = None
-) -> BatchMDP:
+def branch_mdp(mdp: ExplorationMDP, count: int, rng: np.random.Generator | None = None) -> BatchMDP:
     """A :class:`BatchMDP` of ``count`` exact copies of the single-world ``mdp`` mid-episode:
     ``step(actions, active)`` then plays each copy with its own actions as ``mdp.step`` would
     (same belief, positions, slots, rewards and ends). ``rng``: the generator of the env's
