@@ -78,7 +78,7 @@ def branch_mdp(mdp: ExplorationMDP, count: int, rng: np.random.Generator | None 
     if rng is not None:
         batch.rngs = [copy.deepcopy(rng) for _ in rows]
     slots = mdp.slot_arrays()
-    for name in (*slots.__slots__,):
+    for name in slots.__slots__:
         getattr(batch.slots, name)[rows] = getattr(slots, name)
     batch._oscillation._history[rows] = mdp._oscillation._history[0]
     if mdp._trail is not None and batch._trail is not None:

@@ -92,15 +92,17 @@ def rollout_costs(
     left to explore before that costs ``max_cells``."""
     n = sims.n_worlds
     state = _RolloutState(n, max_cells)
-    slots = None if isinstance(base, NearestPathBase) else SlotArrays.empty(n, 1, base.n_slots)
+    nearest = base if isinstance(base, NearestPathBase) else None
+    slots = SlotArrays.empty(n, 1, base.n_slots) if nearest is None else None
     while True:
         _advance(sims, state, start, coverage, max_cells)
         deciding = np.flatnonzero(state.deciding)
         if len(deciding) == 0:
             return state.cost
-        if slots is None:
-            goals = base.decide(sims, deciding)  # type: ignore[attr-defined]
+        if nearest is not None:
+            goals = nearest.decide(sims, deciding)
         else:
+            assert slots is not None
             sims.slots(slots, deciding, False)
             goals = base.goals(sims, slots, deciding)
         stuck = goals[:, 0] < 0  # nothing reachable is left to explore: it cannot finish
