@@ -1,8 +1,10 @@
 """Privileged targets for a map-aware chooser: each candidate's cost-to-go on the true map.
 
 At every real decision of an episode (two or more valid slots) the robot's world is cloned
-once per valid slot; each clone walks to that slot's target and a fixed base policy finishes
-the map (:func:`frontier_marl.policies.lookahead.lookahead_costs`). The cells travelled until
+once per valid slot into one batch (:func:`frontier_marl.sim.branching.branch`); each clone
+walks to that slot's target and a fixed base policy finishes the map, all clones rolled out
+together (:func:`frontier_marl.sim.rollouts.rollout_costs`, through
+:func:`frontier_marl.policies.lookahead.lookahead_costs`). The cells travelled until
 the coverage level are the candidate's cost-to-go. A sample holds what the robot itself sees
 of each candidate (its map crops, :mod:`frontier_marl.policies.map_crops`, and its explorer
 slot features) and the candidates' costs; a scorer that regresses the costs from those inputs
@@ -25,8 +27,9 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.policies.linear_scorer import explorer_slots
-from frontier_marl.policies.lookahead import RolloutBase, lookahead_costs
+from frontier_marl.policies.lookahead import lookahead_costs
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
+from frontier_marl.sim.rollouts import RolloutBase
 
 #: A behaviour: (observation, the decision's candidate inputs) -> the valid slot it takes.
 Behaviour = Callable[[dict[str, np.ndarray], "Candidates"], int]

@@ -1,0 +1,154 @@
+"""Branching (sim/branching.py) and batched rollouts (sim/rollouts.py): a clone steps exactly as
+its original; the rollouts end where they should and give the per-clone route's costs."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frontier_marl.envs.parallel import FrontierParallelEnv
+from frontier_marl.evaluation.benchmark.families import family, variant_configs
+from frontier_marl.evaluation.benchmark.run import oracle, run_family
+from frontier_marl.policies import lookahead
+from frontier_marl.sim.batch_engine import BatchMDP
+from frontier_marl.sim.branching import branch, branch_mdp
+from frontier_marl.sim.engine import ExplorationMDP
+from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "environment.md"
+
+
+def _env(seed: int, prefix: list[int], **kwargs: object) -> FrontierParallelEnv:
+    """An env reset with ``seed`` after playing the valid slots ``prefix`` (modulo the live
+    ones)."""
+    env = FrontierParallelEnv(preset="thesis-20x20", **kwargs)
+    env.reset(seed=seed)
+    for choice in prefix:
+        masks = env.mdp.action_masks()
+        env.mdp.step([_valid(mask, choice + a) for a, mask in enumerate(masks)])
+    return env
+
+
+def _valid(mask: np.ndarray, choice: int) -> int:
+    valid = np.flatnonzero(mask)
+    return int(valid[choice % len(valid)])
+
+
+def _assert_same(single: ExplorationMDP, batch: BatchMDP, row: int) -> None:
+    world, clone = single.world, batch.worlds
+    assert world is not None
+    assert np.array_equal(world.belief, clone.belief[row])
+    assert np.array_equal(world.positions, clone.positions[row])
+    assert np.array_equal(world.travelled, clone.travelled[row])
+    slots = single.slot_arrays()
+    for name in ("target", "valid", "mask", "path_length", "distance", "size", "gain"):
+        assert np.array_equal(getattr(slots, name), getattr(batch.slots, name)[row]), name
+    assert single.steps == batch.steps[row]
+    assert single.last is not None
+    observed = batch.observations(np.array([row]))
+    for agent, obs in enumerate(single.last.observations):
+        if isinstance(obs, dict):
+            for key, value in obs.items():
+                assert np.array_equal(value, observed[key][0, agent]), key
+        else:
+            assert np.array_equal(obs, observed[0, agent])
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"n_agents": 2}, {"commit": "until-reached"}])
+def test_a_clone_steps_exactly_as_its_original(kwargs: dict[str, object]) -> None:
+    prefix = [1, 0, 2]
+    source = _env(3, prefix, **kwargs)
+    futures = [[0, 1, 0, 2, 1], [1, 1, 0, 0, 3]]
+    batch = branch_mdp(source.mdp, len(futures))
+    originals = [_env(3, prefix, **kwargs) for _ in futures]
+    for row, original in enumerate(originals):
+        _assert_same(original.mdp, batch, row)
+    agents = originals[0].config.n_agents
+    for step in range(len(futures[0])):
+        active = ~batch.done
+        if not active.any():
+            break
+        actions = np.zeros((len(futures), agents), dtype=np.int64)
+        for row, original in enumerate(originals):
+            if not active[row]:
+                continue
+            masks = original.mdp.action_masks()
+            chosen = [_valid(masks[a], futures[row][step] + a) for a in range(agents)]
+            actions[row] = chosen
+            original.mdp.step(chosen)
+        batch.step(actions, active)
+        for row, original in enumerate(originals):
+            if not active[row]:
+                continue
+            _assert_same(original.mdp, batch, row)
+            outcome = original.mdp.last.outcome
+            assert np.array_equal(outcome.rewards, batch.outcome.rewards[row])
+            assert outcome.terminated == batch.outcome.terminated[row]
+            assert outcome.truncated == batch.outcome.truncated[row]
+
+
+def test_branch_mdp_needs_an_episode_in_progress() -> None:
+    env = FrontierParallelEnv(preset="thesis-20x20")
+    with pytest.raises(RuntimeError, match="episode in progress"):
+        branch_mdp(env.mdp, 2)
+
+
+def test_clones_do_not_touch_their_source() -> None:
+    env = _env(5, [0, 1])
+    world = env.world
+    belief, positions = world.belief.copy(), world.positions.copy()
+    sims = branch(world.batch, world.index, 3)
+    assert np.array_equal(sims.belief[2], belief)
+    sims.goals[:, 0] = env.mdp.slot_arrays().target[0, 0]
+    rollout_costs(sims, int(world.travelled[0]), 0.99, 1600, NearestPathBase())
+    assert np.array_equal(world.belief, belief)
+    assert np.array_equal(world.positions, positions)
+
+
+def test_rollouts_end_at_coverage_at_the_cap_or_when_stuck() -> None:
+    env = _env(5, [0])
+    world = env.world
+    start = int(world.travelled[0])
+    targets = env.mdp.slot_arrays().target[0, : int(env.mdp.slot_arrays().live[0])]
+    sims = branch(world.batch, world.index, len(targets))
+    sims.goals[:, 0] = targets
+    assert rollout_costs(sims, start, 0.0, 1600, NearestPathBase()).tolist() == [0] * len(targets)
+    sims = branch(world.batch, world.index, len(targets))
+    sims.goals[:, 0] = targets
+    capped = rollout_costs(sims, start, 0.99, 3, NearestPathBase())
+    assert capped.tolist() == [3] * len(targets)
+    assert (sims.travelled[:, 0] - start).tolist() == [3] * len(targets)
+    sims = branch(world.batch, world.index, len(targets))
+    sims.goals[:, 0] = targets
+    stuck = rollout_costs(sims, start, 2.0, 1600, NearestPathBase())  # never covered: stuck
+    assert stuck.tolist() == [1600] * len(targets)
+
+
+def test_oracle_gives_the_per_clone_routes_costs_and_t99() -> None:
+    """Recorded with the per-clone route (lookahead_costs stepping one Worlds batch in
+    lockstep, main at 1fa19b7): random-20, validation episodes 0 and 1."""
+    costs: list[list[int]] = []
+    original = lookahead.lookahead_costs
+
+    def recording(*args: object, **kwargs: object) -> np.ndarray:
+        out = original(*args, **kwargs)  # type: ignore[arg-type]
+        costs.append(out.tolist())
+        return out
+
+    fam = family("random-20")
+    lookahead.lookahead_costs = recording  # type: ignore[assignment]
+    try:
+        result = run_family(fam, oracle(), variant_configs(fam), 2, split="validation")
+    finally:
+        lookahead.lookahead_costs = original  # type: ignore[assignment]
+    assert [e.cells_to_coverage["0.99"] for e in result.episodes] == [88.0, 112.0]
+    assert costs[:3] == [[93, 107], [92, 104], [91, 89]]
+
+
+def test_the_documented_example_runs() -> None:
+    section = DOCS.read_text().split("## Branching")[1].split("\n## ")[0]
+    (snippet,) = re.findall(r"```python\n(.*?)```", section, flags=re.DOTALL)
+    exec(compile(snippet, str(DOCS), "exec"), {"__name__": "snippet"})
