@@ -145,6 +145,8 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     assert main(["train", "explorer-map", "--out", str(out), "--no-progress", *sets]) == 0
     records = [json.loads(line) for line in (out / "validation.jsonl").read_text().splitlines()]
     assert [r["round"] for r in records] == [0, 1] and records[1]["labels"] > records[0]["labels"]
+    tried = records[0]["by_rule_weight_and_family"]
+    assert set(tried) == {"0.0", "0.5", "2.0"} and set(tried["0.5"]) == {"random-20"}
     assert map_scorer_folder(out / "best") == out / "best"
     model, meta = load_scorer(out / "best")
     assert meta["format"] == "map-scorer" and meta["env_settings"]["n_slots"] == 12

@@ -63,6 +63,7 @@ def _round_record(
     record = {"round": round_, "labels": n_labels, **tried[weight]}
     record["rule_weight"] = weight
     record["by_rule_weight"] = {str(w): t["vs_frontier_rule"] for w, t in tried.items()}
+    record["by_rule_weight_and_family"] = {str(w): t["by_family"] for w, t in tried.items()}
     return record
 
 
