@@ -49,6 +49,7 @@ from frontier_marl.experiments.results import (
 from frontier_marl.policies.metadata import load_metadata
 from frontier_marl.policies.model_files import list_checkpoints, newest_good_checkpoint
 from frontier_marl.training.experiment import experiment_from_dict, load_experiment
+from frontier_marl.utils.parallel import init_ray
 
 __all__ = ["CampaignResult", "RayNotInstalledError", "TrialSpec", "build_grid", "run_campaign"]
 
@@ -281,22 +282,13 @@ class _CampaignSettings:
 
 def _init_ray(address: str | None, log: Callable[[str], None]) -> bool:
     """Start or connect to Ray unless it is already initialised; whether it was started."""
-    import ray
-
-    if not ray.is_initialized():
-        try:
-            ray.init(
-                address=address,
-                include_dashboard=False,
-                log_to_driver=False,
-                configure_logging=False,
-            )
-        except ConnectionError as exc:
-            raise ValueError(f"--address {address}: cannot connect to Ray: {exc}") from exc
-        return True
-    if address is not None:
+    try:
+        started = init_ray(address)
+    except ConnectionError as exc:
+        raise ValueError(f"--address {address}: {exc}") from exc
+    if not started and address is not None:
         log(f"note: Ray is already initialised; ignoring --address {address}")
-    return False
+    return started
 
 
 def _log_start(

@@ -234,19 +234,24 @@ def _call(fn: Callable, task: Any) -> Any:
     return fn(task)
 
 
+def init_ray(address: str | None) -> bool:
+    """Start Ray, or connect to ``address``, unless it is already initialised; whether this
+    call did (ConnectionError naming the address)."""
+    ray = require_ray()
+    if ray.is_initialized():
+        return False
+    try:
+        ray.init(
+            address=address, include_dashboard=False, log_to_driver=False, configure_logging=False
+        )
+    except ConnectionError as exc:
+        raise ConnectionError(f"ray address {address!r}: cannot connect to Ray: {exc}") from exc
+    return True
+
+
 def _on_ray(fn: Callable, tasks: list, address: str, label: Callable, done: _Done) -> list:
     ray = require_ray()
-    started = not ray.is_initialized()
-    if started:
-        try:
-            ray.init(
-                address=address,
-                include_dashboard=False,
-                log_to_driver=False,
-                configure_logging=False,
-            )
-        except ConnectionError as exc:
-            raise ConnectionError(f"ray address {address!r}: cannot connect to Ray: {exc}") from exc
+    started = init_ray(address)
     try:
         remote = ray.remote(num_cpus=1)(_call)
         refs = [remote.remote(fn, task) for task in tasks]
