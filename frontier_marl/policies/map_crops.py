@@ -32,7 +32,9 @@ SCALES = (1, 3, 9)
 CHANNELS = ("unknown", "obstacle", "frontier", "cluster", "distance")
 DISTANCE_SCALE = 64.0  # cells: the distance channel reads 1 from here on
 _HALF = SIDE // 2
-_PAD = (_HALF + 1) * max(SCALES)  # margin that every window fits in
+#: What each plane of :func:`map_planes` reads beyond the map's edge: known obstacle, no
+#: frontier, unreachable.
+_OUTSIDE = np.array([0.0, 1.0, 0.0, 1.0])
 
 
 def crop_shape() -> tuple[int, int, int]:
@@ -61,10 +63,7 @@ def candidate_crops(
     targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
     count = len(targets)
     shared = _window_means(planes, targets)  # (M, S, 4, SIDE, SIDE)
-    cluster = np.zeros((count, len(SCALES), SIDE, SIDE))
-    for m, cells in enumerate(cluster_cells):
-        for k, scale in enumerate(SCALES):
-            cluster[m, k] = _binned(np.asarray(cells).reshape(-1, 2), targets[m], scale)
+    cluster = _cluster_windows(cluster_cells, targets)  # (M, S, SIDE, SIDE)
     stacked = np.concatenate(
         [shared[:, :, :3], cluster[:, :, None], shared[:, :, 3:]], axis=2
     )  # channel order of CHANNELS
@@ -88,34 +87,31 @@ def slot_crops(env: Any, slots: np.ndarray, robot: int = 0) -> np.ndarray:
 
 
 def _window_means(planes: np.ndarray, targets: np.ndarray) -> np.ndarray:
-    """(M, S, P, SIDE, SIDE) mean of each plane over each window cell (beyond the map: the
-    outside values of :func:`_padded`)."""
-    tables = _summed_areas(_padded(planes))  # (P, H + 2 pad + 1, W + 2 pad + 1)
+    """(M, S, P, SIDE, SIDE) mean of each plane over each window cell; the part of a window
+    beyond the map reads the plane's :data:`_OUTSIDE` value. Every plane value is a multiple
+    of 1/64, so the summed areas are exact and any order of summation gives the same means."""
+    height, width = planes.shape[1:]
+    tables = _summed_areas(planes)  # (P, H + 1, W + 1)
+    outside = _OUTSIDE[:, None, None, None]
     offsets = np.arange(SIDE) - _HALF
     out = np.empty((len(targets), len(SCALES), len(planes), SIDE, SIDE))
     for k, scale in enumerate(SCALES):
-        low = offsets * scale - scale // 2 + _PAD  # window start per crop row, padded coords
+        low = offsets * scale - scale // 2  # window start per crop row, relative to the target
         rows = targets[:, 0, None] + low  # (M, SIDE)
         cols = targets[:, 1, None] + low
-        top, bottom = rows[:, :, None], rows[:, :, None] + scale
-        left, right = cols[:, None, :], cols[:, None, :] + scale
+        top, bottom = np.clip(rows, 0, height), np.clip(rows + scale, 0, height)
+        left, right = np.clip(cols, 0, width), np.clip(cols + scale, 0, width)
+        top, bottom = top[:, :, None], bottom[:, :, None]
+        left, right = left[:, None, :], right[:, None, :]
+        inside = (bottom - top) * (right - left)  # (M, SIDE, SIDE) map cells in each window
         sums = (
             tables[:, top, left]
             - tables[:, top, right]
             - tables[:, bottom, left]
             + tables[:, bottom, right]
+            + outside * (scale * scale - inside)
         )  # (P, M, SIDE, SIDE)
         out[:, k] = np.moveaxis(sums, 0, 1) / (scale * scale)
-    return out
-
-
-def _padded(planes: np.ndarray) -> np.ndarray:
-    """The planes with a margin of :data:`_PAD` cells: beyond the map is known obstacle, no
-    frontier, unreachable."""
-    outside = np.array([0.0, 1.0, 0.0, 1.0])[:, None, None]
-    count, height, width = planes.shape
-    out = np.broadcast_to(outside, (count, height + 2 * _PAD, width + 2 * _PAD)).copy()
-    out[:, _PAD : _PAD + height, _PAD : _PAD + width] = planes
     return out
 
 
@@ -124,15 +120,23 @@ def _summed_areas(planes: np.ndarray) -> np.ndarray:
     columns < c."""
     count, height, width = planes.shape
     tables = np.zeros((count, height + 1, width + 1))
-    tables[:, 1:, 1:] = planes.cumsum(axis=1).cumsum(axis=2)
+    np.cumsum(planes, axis=1, out=tables[:, 1:, 1:])
+    np.cumsum(tables[:, 1:, 1:], axis=2, out=tables[:, 1:, 1:])
     return tables
 
 
-def _binned(cells: np.ndarray, target: np.ndarray, scale: int) -> np.ndarray:
-    """(SIDE, SIDE) fraction of each window cell's map cells that are in ``cells``."""
-    grid = np.zeros((SIDE, SIDE))
-    shifted = cells - target + scale // 2 + _HALF * scale
-    index = np.floor_divide(shifted, scale)
-    inside = ((index >= 0) & (index < SIDE)).all(axis=1)
-    np.add.at(grid, (index[inside, 0], index[inside, 1]), 1.0)
-    return grid / (scale * scale)
+def _cluster_windows(cluster_cells: list[np.ndarray], targets: np.ndarray) -> np.ndarray:
+    """(M, S, SIDE, SIDE) fraction of each window cell's map cells that are in candidate m's
+    cluster, at every scale, counted in one ``bincount``."""
+    count, n_scales = len(targets), len(SCALES)
+    cells = [np.asarray(c, dtype=np.int64).reshape(-1, 2) for c in cluster_cells]
+    owner = np.repeat(np.arange(count), [len(c) for c in cells])
+    shifted = np.concatenate([*cells, np.zeros((0, 2), np.int64)]) - targets[owner]
+    counts = np.zeros(count * n_scales * SIDE * SIDE)
+    for k, scale in enumerate(SCALES):
+        index = np.floor_divide(shifted + scale // 2 + _HALF * scale, scale)
+        inside = ((index >= 0) & (index < SIDE)).all(axis=1)
+        flat = ((owner[inside] * n_scales + k) * SIDE + index[inside, 0]) * SIDE
+        counts += np.bincount(flat + index[inside, 1], minlength=len(counts))
+    scale_area = np.array(SCALES, dtype=np.float64)[None, :, None, None] ** 2
+    return counts.reshape(count, n_scales, SIDE, SIDE) / scale_area
