@@ -15,6 +15,9 @@ from frontier_marl.config import make_config  # noqa: E402
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN  # noqa: E402
 from frontier_marl.evaluation.benchmark import families as map_families  # noqa: E402
 from frontier_marl.evaluation.benchmark.contenders import map_model  # noqa: E402
+from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (  # noqa: E402
+    main as ablation_main,
+)
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
 from frontier_marl.policies.linear_scorer import feature_names  # noqa: E402
@@ -33,7 +36,7 @@ from frontier_marl.training.cost_to_go import (  # noqa: E402
     relative_regret,
 )
 from frontier_marl.training.experiment import load_experiment  # noqa: E402
-from frontier_marl.training.regression import group, symmetry  # noqa: E402
+from frontier_marl.training.regression import batch_loss, fit, group, symmetry  # noqa: E402
 
 
 def window_mean(plane: np.ndarray, outside: float, target, scale: int, i: int, j: int) -> float:
@@ -165,6 +168,30 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     assert {"scorer (rule weight 0)", "scorer (rule weight 1)", "frontier-rule"} <= set(choosers)
     assert all(0 <= c["cheapest"] <= 1 and c["regret"] >= 0 for c in choosers.values())
     assert [r["policy"] for r in probe["rows"]] == ["frontier-rule", "scorer-w0", "scorer-w1"]
+    ablation_json = tmp_path / "ablation.json"
+    ablation_args = ["--variants", "full,no-map,argmax", "--weights", "0", "--episodes", "1"]
+    ablation_args += ["--epochs", "1", "--json", str(ablation_json)]
+    assert ablation_main([str(out), *ablation_args]) == 0
+    variants = json.loads(ablation_json.read_text())["variants"]
+    assert list(variants) == ["full", "no-map", "argmax"]
+    for variant in variants.values():
+        (held_out,) = variant["held_out_decisions"].values()  # round 1's random-20 decisions
+        assert held_out["decisions"] > 0 and "frontier-rule" in held_out["choosers"]
+        assert set(variant["validation"]["0.0"]["by_family"]) == {"random-20"}
+
+
+def test_the_fit_losses_have_their_known_values() -> None:
+    regret = torch.tensor([[0.0, 0.5, 9.0]])
+    mask = torch.tensor([[True, True, False]])
+    predicted = torch.tensor([[0.0, 0.0, float("inf")]])  # the scorer cannot tell them apart
+    assert batch_loss("regret", predicted, regret, mask).item() == pytest.approx(0.125)
+    half = torch.log(torch.tensor(2.0)).item()  # -log(1/2): either candidate is as likely
+    assert batch_loss("argmax", predicted, regret, mask).item() == pytest.approx(half)
+    assert batch_loss("ranking", predicted, regret, mask).item() == pytest.approx(half)
+    sure = torch.tensor([[0.0, 20.0, float("inf")]])  # the cheapest one, surely
+    assert batch_loss("argmax", sure, regret, mask).item() == pytest.approx(0.0, abs=1e-6)
+    with pytest.raises(ValueError, match="unknown loss 'hinge'"):
+        fit(new_scorer(14, 8), None, 1, loss="hinge")  # type: ignore[arg-type]
 
 
 def test_the_benchmark_plays_a_saved_scorer_with_its_saved_rule_weight(tmp_path: Path) -> None:

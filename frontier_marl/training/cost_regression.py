@@ -162,14 +162,15 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Sam
     return label_episode(cfg, episode, behaviour, family=name)
 
 
-def fitted(samples: Samples, reg: RegressionSettings, seed: int) -> Any:
-    """A new scorer fitted to ``samples``."""
+def fitted(samples: Samples, reg: RegressionSettings, seed: int, loss: str = "regret") -> Any:
+    """A new scorer fitted to ``samples`` (with ``loss``, :data:`~frontier_marl.training.
+    regression.LOSSES`)."""
     decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]))
     model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))
-    fit(model, decisions, reg.fit_epochs, reg.fit_batch, reg.fit_rate, seed)
+    fit(model, decisions, reg.fit_epochs, reg.fit_batch, reg.fit_rate, seed, loss=loss)
     model.eval()
     return model
 

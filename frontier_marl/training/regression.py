@@ -2,10 +2,13 @@
 
 The samples are grouped by decision into padded tensors (at most ``n_slots`` candidates, a
 mask for the rest). The target of each candidate is its relative regret
-(:func:`~frontier_marl.training.cost_to_go.relative_regret`); the loss is the mean squared
-error over the valid candidates. Each batch is seen in one of the eight symmetries of the
-square (the crops rotated or mirrored, the target's row and column offsets turned alike), so
-the scorer learns that a corridor going north is a corridor going east.
+(:func:`~frontier_marl.training.cost_to_go.relative_regret`). The loss (:data:`LOSSES`) is the
+mean squared error over the valid candidates (``"regret"``: the shipped fit); the ablation
+(:mod:`~frontier_marl.experiments.explorer_studies.map_scorer_ablation`) also fits a listwise
+``"ranking"`` loss and ``"argmax"`` imitation of the cheapest candidate. Each batch is seen in
+one of the eight symmetries of the square (the crops rotated or mirrored, the target's row and
+column offsets turned alike), so the scorer learns that a corridor going north is a corridor
+going east.
 """
 
 from __future__ import annotations
@@ -20,6 +23,11 @@ from frontier_marl.training.cost_to_go import Samples, relative_regret
 
 #: Columns of the explorer features that are offsets on the grid: (row, col).
 OFFSET_COLUMNS = (2, 3)
+#: The fit's losses: squared error on the regret; cross entropy between the scorer's softmax
+#: over the candidates (of minus the predicted regret) and the softmax of minus the true regret
+#: over :data:`RANKING_TEMPERATURE` (``"ranking"``) or the cheapest candidate (``"argmax"``).
+LOSSES = ("regret", "ranking", "argmax")
+RANKING_TEMPERATURE = 0.05  # a regret 0.05 dearer than another: e times less likely
 
 
 @dataclass
@@ -84,8 +92,11 @@ def fit(
     learning_rate: float = 1e-3,
     seed: int = 0,
     on_epoch: object = None,
+    loss: str = "regret",
 ) -> list[float]:
-    """Adam on the masked squared error; returns the mean training loss of each epoch."""
+    """Adam on ``loss`` (:data:`LOSSES`); returns the mean training loss of each epoch."""
+    if loss not in LOSSES:
+        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
     generator = torch.Generator().manual_seed(seed)
     optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate)
     losses = []
@@ -98,16 +109,30 @@ def fit(
             k = int(torch.randint(8, (1,), generator=generator))
             crops, features = symmetry(train.crops[rows].float() / 255.0, train.features[rows], k)
             mask = train.mask[rows]
-            predicted = model(crops, features, mask)
-            loss = ((predicted - train.regret[rows])[mask] ** 2).mean()
+            value = batch_loss(loss, model(crops, features, mask), train.regret[rows], mask)
             optimiser.zero_grad()
-            loss.backward()
+            value.backward()
             optimiser.step()
-            total, batches = total + loss.item(), batches + 1
+            total, batches = total + value.item(), batches + 1
         losses.append(total / max(batches, 1))
         if callable(on_epoch):
             on_epoch(epoch, losses[-1])
     return losses
+
+
+def batch_loss(
+    kind: str, predicted: torch.Tensor, regret: torch.Tensor, mask: torch.Tensor
+) -> torch.Tensor:
+    """The ``kind`` loss (:data:`LOSSES`) of one batch of decisions."""
+    if kind == "regret":
+        return ((predicted - regret)[mask] ** 2).mean()
+    if kind == "ranking":
+        target = torch.softmax((-regret / RANKING_TEMPERATURE).masked_fill(~mask, -1e9), dim=1)
+    else:
+        cheapest = regret.masked_fill(~mask, float("inf")).argmin(dim=1)
+        target = torch.nn.functional.one_hot(cheapest, mask.shape[1]).to(predicted.dtype)
+    chosen = torch.log_softmax((-predicted).masked_fill(~mask, -1e9), dim=1)
+    return -(target * chosen).masked_fill(~mask, 0.0).sum(dim=1).mean()
 
 
 @torch.no_grad()
