@@ -170,9 +170,11 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     assert [r["policy"] for r in probe["rows"]] == ["frontier-rule", "scorer-w0", "scorer-w1"]
     ablation_json = tmp_path / "ablation.json"
     ablation_args = ["--variants", "full,no-map,argmax", "--weights", "0", "--episodes", "1"]
-    ablation_args += ["--epochs", "1", "--json", str(ablation_json)]
+    ablation_args += ["--epochs", "1", "--train-rounds", "1", "--json", str(ablation_json)]
     assert ablation_main([str(out), *ablation_args]) == 0
-    variants = json.loads(ablation_json.read_text())["variants"]
+    ablation = json.loads(ablation_json.read_text())
+    assert ablation["train_rounds"] == 1 and ablation["train_labels"] == records[0]["labels"]
+    variants = ablation["variants"]
     assert list(variants) == ["full", "no-map", "argmax"]
     for variant in variants.values():
         (held_out,) = variant["held_out_decisions"].values()  # round 1's random-20 decisions

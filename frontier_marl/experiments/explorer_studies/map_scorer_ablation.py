@@ -2,8 +2,8 @@
 validation seeds (docs/experiments/2026-12-04-map-aware-explorer.md).
 
 A cost-regression run (``frontier-marl train explorer-map``) keeps each round's labels in
-``RUN/labels/``. This fits one scorer per variant on every round but the last, with the
-run's fit settings (``[regression]``):
+``RUN/labels/``. This fits one scorer per variant on every round but the last (or the first
+``--train-rounds``: a learning curve), with the run's fit settings (``[regression]``):
 
 * ``full``: the shipped fit, squared error on each candidate's relative regret, reading the
   map crops and the slot features;
@@ -111,6 +111,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--weights", default="0,0.5", help="rule weights, comma-separated")
     parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
     parser.add_argument("--epochs", type=int, default=None, help="default: the run's")
+    parser.add_argument(
+        "--train-rounds",
+        type=int,
+        default=None,
+        help="fit on the first N rounds (default: all but the last)",
+    )
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
     variants = args.variants.split(",")
@@ -126,9 +132,18 @@ def main(argv: list[str] | None = None) -> int:
     reg = RegressionSettings(**experiment.regression)
     if args.epochs is not None:
         reg = RegressionSettings(**{**experiment.regression, "fit_epochs": args.epochs})
-    train, test = Samples.join(rounds[:-1]), rounds[-1]
+    fitted_rounds = len(rounds) - 1 if args.train_rounds is None else args.train_rounds
+    if not 1 <= fitted_rounds < len(rounds):
+        parser.error(f"--train-rounds must be in [1, {len(rounds) - 1}], got {fitted_rounds}")
+    train, test = Samples.join(rounds[:fitted_rounds]), rounds[-1]
     validation = Validation(list(experiment.train.families), args.episodes)
-    report: dict[str, Any] = {"run": str(args.run), "episodes": args.episodes, "variants": {}}
+    report: dict[str, Any] = {
+        "run": str(args.run),
+        "train_rounds": fitted_rounds,
+        "train_labels": len(train),
+        "episodes": args.episodes,
+        "variants": {},
+    }
     for name in variants:
         model = fit_variant(name, train, reg, experiment.train.seed)
         decisions = held_out_report(model, test, weights)
