@@ -31,6 +31,7 @@ from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
 from frontier_marl.training.cost_regression import scorer_config  # noqa: E402
 from frontier_marl.training.cost_to_go import (  # noqa: E402
     Samples,
+    cells_regret,
     first_choice_of,
     label_episode,
     relative_regret,
@@ -78,6 +79,26 @@ def test_crops_are_window_means_of_the_belief_on_a_non_square_map() -> None:
 def test_relative_regret_is_the_cost_over_the_cheapest_of_its_decision() -> None:
     regret = relative_regret(np.array([10.0, 15.0, 40.0, 0.0, 3.0]), np.array([0, 0, 0, 1, 1]))
     np.testing.assert_allclose(regret, [0.0, 0.5, 1.0, 0.0, 1.0])  # capped at 1; 0 cells: 1
+
+
+def test_cells_regret_is_the_extra_cost_over_the_map_side() -> None:
+    cost, decision = np.array([10.0, 15.0, 40.0, 7.0, 3.0]), np.array([0, 0, 0, 1, 1])
+    regret = cells_regret(cost, decision, np.array([10.0, 10.0, 10.0, 2.0, 2.0]))
+    np.testing.assert_allclose(regret, [0.0, 0.5, 1.5, 1.5, 0.0])  # 3.0 and 2.0 capped at 1.5
+
+
+def test_grouped_decisions_keep_each_candidates_extra_cells() -> None:
+    samples = Samples(
+        crops=np.zeros((5, *map_crops.crop_shape()), np.uint8),
+        features=np.arange(5, dtype=np.float32)[:, None],
+        cost=np.array([7.0, 3.0, 10.0, 15.0, 40.0]),
+        decision=np.array([1, 1, 0, 0, 0]),
+        family=np.full(5, "random-20"),
+    )
+    grouped = group(samples, 4)
+    assert grouped.features[..., 0].tolist() == [[2, 3, 4, 0], [0, 1, 0, 0]]
+    assert grouped.extra.tolist() == [[0, 5, 30, 0], [4, 0, 0, 0]]
+    np.testing.assert_allclose(grouped.regret[0, :3], [0.0, 0.5, 1.0])
 
 
 def test_a_quarter_turn_turns_the_crops_and_the_offsets_alike() -> None:
@@ -169,13 +190,13 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     assert all(0 <= c["cheapest"] <= 1 and c["regret"] >= 0 for c in choosers.values())
     assert [r["policy"] for r in probe["rows"]] == ["frontier-rule", "scorer-w0", "scorer-w1"]
     ablation_json = tmp_path / "ablation.json"
-    ablation_args = ["--variants", "full,no-map,argmax", "--weights", "0", "--episodes", "1"]
+    ablation_args = ["--variants", "full,no-map,cells", "--weights", "0", "--episodes", "1"]
     ablation_args += ["--epochs", "1", "--train-rounds", "1", "--json", str(ablation_json)]
     assert ablation_main([str(out), *ablation_args]) == 0
     ablation = json.loads(ablation_json.read_text())
     assert ablation["train_rounds"] == 1 and ablation["train_labels"] == records[0]["labels"]
     variants = ablation["variants"]
-    assert list(variants) == ["full", "no-map", "argmax"]
+    assert list(variants) == ["full", "no-map", "cells"]
     for variant in variants.values():
         (held_out,) = variant["held_out_decisions"].values()  # round 1's random-20 decisions
         assert held_out["decisions"] > 0 and "frontier-rule" in held_out["choosers"]

@@ -162,10 +162,16 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Sam
     return label_episode(cfg, episode, behaviour, family=name)
 
 
-def fitted(samples: Samples, reg: RegressionSettings, seed: int, loss: str = "regret") -> Any:
+def fitted(
+    samples: Samples,
+    reg: RegressionSettings,
+    seed: int,
+    loss: str = "regret",
+    scale: np.ndarray | None = None,
+) -> Any:
     """A new scorer fitted to ``samples`` (with ``loss``, :data:`~frontier_marl.training.
-    regression.LOSSES`)."""
-    decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]))
+    regression.LOSSES`, on the target of :func:`~frontier_marl.training.regression.group`)."""
+    decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]), scale)
     model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))

@@ -147,6 +147,17 @@ def relative_regret(cost: np.ndarray, decision: np.ndarray, cap: float = 1.0) ->
     return np.minimum(np.maximum(cost, 1.0) / cheapest - 1.0, cap)
 
 
+def cells_regret(
+    cost: np.ndarray, decision: np.ndarray, scale: np.ndarray, cap: float = 1.5
+) -> np.ndarray:
+    """Per candidate, the cells it costs beyond the cheapest of its decision's, over its
+    ``scale`` (cells, per candidate: the map's side, so that every decision of every map size
+    weighs by its share of an episode), capped at ``cap``."""
+    best = np.full(int(decision.max()) + 1, np.inf)
+    np.minimum.at(best, decision, cost)
+    return np.minimum((cost - best[decision]) / scale, cap)
+
+
 def first_choice_of(scores: Callable[[dict[str, np.ndarray], Candidates], np.ndarray]) -> Any:
     """A behaviour taking the candidate of lowest ``scores`` (ties: the lower slot)."""
 

@@ -2,7 +2,8 @@
 
 The samples are grouped by decision into padded tensors (at most ``n_slots`` candidates, a
 mask for the rest). The target of each candidate is its relative regret
-(:func:`~frontier_marl.training.cost_to_go.relative_regret`). The loss (:data:`LOSSES`) is the
+(:func:`~frontier_marl.training.cost_to_go.relative_regret`; the ablation also tries the regret
+in cells over the map's side). The loss (:data:`LOSSES`) is the
 mean squared error over the valid candidates (``"regret"``: the shipped fit); the ablation
 (:mod:`~frontier_marl.experiments.explorer_studies.map_scorer_ablation`) also fits a listwise
 ``"ranking"`` loss and ``"argmax"`` imitation of the cheapest candidate. Each batch is seen in
@@ -19,7 +20,7 @@ import numpy as np
 import torch
 
 from frontier_marl.policies.networks.map_scorer import MapScorer
-from frontier_marl.training.cost_to_go import Samples, relative_regret
+from frontier_marl.training.cost_to_go import Samples, cells_regret, relative_regret
 
 #: Columns of the explorer features that are offsets on the grid: (row, col).
 OFFSET_COLUMNS = (2, 3)
@@ -33,12 +34,14 @@ RANKING_TEMPERATURE = 0.05  # a regret 0.05 dearer than another: e times less li
 @dataclass
 class Decisions:
     """Samples grouped by decision: ``crops`` uint8 (D, M, C, S, S), ``features`` float32
-    (D, M, F), ``regret`` float32 (D, M), ``mask`` bool (D, M)."""
+    (D, M, F), ``regret`` float32 (D, M) the fit's target, ``mask`` bool (D, M), ``extra``
+    float32 (D, M) each candidate's cells beyond its decision's cheapest (uncapped)."""
 
     crops: torch.Tensor
     features: torch.Tensor
     regret: torch.Tensor
     mask: torch.Tensor
+    extra: torch.Tensor
 
     def __len__(self) -> int:
         return len(self.mask)
@@ -46,18 +49,24 @@ class Decisions:
     def subset(self, rows: np.ndarray) -> Decisions:
         index = torch.as_tensor(rows)
         return Decisions(
-            self.crops[index], self.features[index], self.regret[index], self.mask[index]
+            self.crops[index],
+            self.features[index],
+            self.regret[index],
+            self.mask[index],
+            self.extra[index],
         )
 
 
-def group(samples: Samples, n_slots: int, cap: float = 1.0) -> Decisions:
-    """The decisions of ``samples`` as padded tensors of ``n_slots`` candidates."""
+def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> Decisions:
+    """The decisions of ``samples`` as padded tensors of ``n_slots`` candidates; the target is
+    the relative regret, or with ``scale`` (cells, per sample) the regret in cells over it
+    (:func:`~frontier_marl.training.cost_to_go.cells_regret`)."""
     _, order, counts = np.unique(samples.decision, return_inverse=True, return_counts=True)
     if counts.max() > n_slots:
         raise ValueError(f"a decision has {counts.max()} candidates, more than {n_slots}")
-    rank = np.zeros(len(samples), dtype=np.int64)
-    for d in range(len(counts)):  # candidates keep their order within a decision
-        rank[order == d] = np.arange(counts[d])
+    rank = np.empty(len(samples), dtype=np.int64)  # candidates keep their order in a decision
+    by_decision = np.argsort(order, kind="stable")
+    rank[by_decision] = np.arange(len(samples)) - np.repeat(np.cumsum(counts) - counts, counts)
     shape = (len(counts), n_slots)
     crops = np.zeros((*shape, *samples.crops.shape[1:]), dtype=np.uint8)
     features = np.zeros((*shape, samples.features.shape[1]), dtype=np.float32)
@@ -65,9 +74,15 @@ def group(samples: Samples, n_slots: int, cap: float = 1.0) -> Decisions:
     mask = np.zeros(shape, dtype=bool)
     crops[order, rank] = samples.crops
     features[order, rank] = samples.features
-    regret[order, rank] = relative_regret(samples.cost, order, cap)
+    regret[order, rank] = (
+        relative_regret(samples.cost, order)
+        if scale is None
+        else cells_regret(samples.cost, order, scale)
+    )
     mask[order, rank] = True
-    return Decisions(*(torch.as_tensor(a) for a in (crops, features, regret, mask)))
+    extra = np.zeros(shape, dtype=np.float32)
+    extra[order, rank] = cells_regret(samples.cost, order, np.ones(len(samples)), np.inf)
+    return Decisions(*(torch.as_tensor(a) for a in (crops, features, regret, mask, extra)))
 
 
 def symmetry(crops: torch.Tensor, features: torch.Tensor, k: int) -> tuple[torch.Tensor, ...]:

@@ -11,12 +11,17 @@ A cost-regression run (``frontier-marl train explorer-map``) keeps each round's 
 * ``ranking``: a listwise ranking loss in place of the regression
   (:data:`~frontier_marl.training.regression.LOSSES`);
 * ``argmax``: imitation of each decision's cheapest candidate (the argmax labels that DAgger
-  imitated before the cost targets).
+  imitated before the cost targets);
+* ``cells``: the regression on each candidate's cells beyond its decision's cheapest, over the
+  map's side (:func:`~frontier_marl.training.cost_to_go.cells_regret`), in place of the
+  relative regret: every decision weighs by its share of an episode, where the relative regret
+  weighs the last decisions, whose costs are small, the most.
 
 Each is reported (a) on the last round's decisions (other training episodes, held out of the
 fit) per family, as :func:`~frontier_marl.experiments.explorer_studies.map_scorer_probe.
-decision_report` gives it: how often it takes the cheapest candidate, the mean regret of its
-choice beside frontier-rule's and the nearest path's, its rank correlation with the true costs;
+decision_report` gives it: how often it takes the cheapest candidate, the mean relative regret
+and the mean cells beyond the cheapest of its choice beside frontier-rule's and the nearest
+path's, its rank correlation with the true costs;
 and (b) by its T99 against frontier-rule on ``--episodes`` validation episodes of every family,
 at each rule weight of ``--weights`` (:class:`~frontier_marl.policies.map_explorer.MapExplorer`;
 the cross-entropy variants score in other units, so their weights are not comparable)::
@@ -36,6 +41,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from frontier_marl.evaluation.benchmark.families import family, variant_configs
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import decision_report
 from frontier_marl.training.cost_regression import Validation, fitted
 from frontier_marl.training.cost_to_go import Samples
@@ -43,12 +49,14 @@ from frontier_marl.training.experiment import Experiment, experiment_from_dict
 from frontier_marl.training.regression import group
 from frontier_marl.training.settings import RegressionSettings
 
-#: Each variant: its fit's loss and whether it reads the map crops.
-VARIANTS: dict[str, tuple[str, bool]] = {
-    "full": ("regret", True),
-    "no-map": ("regret", False),
-    "ranking": ("ranking", True),
-    "argmax": ("argmax", True),
+#: Each variant: its fit's loss, whether it reads the map crops, whether its target is in
+#: cells (over the map's side) rather than relative.
+VARIANTS: dict[str, tuple[str, bool, bool]] = {
+    "full": ("regret", True, False),
+    "no-map": ("regret", False, False),
+    "ranking": ("ranking", True, False),
+    "argmax": ("argmax", True, False),
+    "cells": ("regret", True, True),
 }
 
 
@@ -64,6 +72,15 @@ class BlankMap(nn.Module):
         self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor
     ) -> torch.Tensor:
         return self.model(torch.zeros_like(crops), features, mask)
+
+
+def map_sides(families: np.ndarray) -> np.ndarray:
+    """Per sample, the square root of its family's map area (cells)."""
+    side = {}
+    for name in set(families.tolist()):
+        (world,) = variant_configs(family(name), None, 1)
+        side[name] = float(np.sqrt(world.height * world.width))
+    return np.array([side[name] for name in families.tolist()])
 
 
 def run_labels(run: Path) -> list[Samples]:
@@ -82,13 +99,13 @@ def run_experiment(run: Path) -> Experiment:
 
 def fit_variant(name: str, train: Samples, reg: RegressionSettings, seed: int) -> nn.Module:
     """The ``name`` variant's scorer fitted to ``train``."""
-    loss, reads_map = VARIANTS[name]
+    loss, reads_map, in_cells = VARIANTS[name]
     if not reads_map:
         train = Samples(
             np.zeros_like(train.crops), train.features, train.cost, train.decision, train.family
         )
     torch.manual_seed(seed)
-    model = fitted(train, reg, seed, loss)
+    model = fitted(train, reg, seed, loss, map_sides(train.family) if in_cells else None)
     return model if reads_map else BlankMap(model).eval()
 
 
@@ -159,7 +176,10 @@ def _print_variant(name: str, decisions: dict[str, Any], episodes: dict[str, Any
     print(f"{name}:")
     for family_name, part in decisions.items():
         choosers = part["choosers"]
-        regrets = ", ".join(f"{label} {row['regret']:.4f}" for label, row in choosers.items())
+        regrets = ", ".join(
+            f"{label} {row['regret']:.4f} ({row['cells']:.2f} cells)"
+            for label, row in choosers.items()
+        )
         print(f"  {family_name} held-out regret: {regrets}; spearman {part['spearman']:.3f}")
     for weight, result in episodes.items():
         families = ", ".join(f"{k} {v:+.1%}" for k, v in result["by_family"].items())

@@ -54,8 +54,9 @@ def validation_labels(names: list[str], episodes: int) -> dict[str, Samples]:
 
 
 def decision_report(model: Any, data: Decisions, weights: list[float]) -> dict[str, Any]:
-    """Per chooser: the share of decisions where it took the cheapest candidate and the mean
-    regret of its choice; the scorer's mean per-decision Spearman correlation."""
+    """Per chooser: the share of decisions where it took the cheapest candidate, the mean
+    regret of its choice (``data.regret``) and the mean cells it costs beyond the cheapest; the
+    scorer's mean per-decision Spearman correlation."""
     rule_vector = torch.as_tensor(list(FRONTIER_RULE_WEIGHTS.values()), dtype=torch.float32)
     rule = data.features @ rule_vector
     margin = rule.masked_fill(~data.mask, -np.inf).max(dim=1, keepdim=True).values - rule
@@ -72,6 +73,7 @@ def decision_report(model: Any, data: Decisions, weights: list[float]) -> dict[s
         rows[label] = {
             "cheapest": float((regret == 0).float().mean()),
             "regret": float(regret.mean()),
+            "cells": float(data.extra[torch.arange(len(data)), best].mean()),
         }
     return {"decisions": len(data), "choosers": rows, "spearman": _spearman(predicted, data)}
 
@@ -101,7 +103,10 @@ def _decisions(
     for name, part in decisions.items():
         print(f"{name}: {part['decisions']} decisions, spearman {part['spearman']:.3f}")
         for label, row in part["choosers"].items():
-            print(f"  {label:<26} cheapest {row['cheapest']:.1%}  regret {row['regret']:.4f}")
+            print(
+                f"  {label:<26} cheapest {row['cheapest']:.1%}  regret {row['regret']:.4f}  "
+                f"cells {row['cells']:.2f}"
+            )
     return decisions
 
 
