@@ -89,7 +89,8 @@ def slot_crops(env: Any, slots: np.ndarray, robot: int = 0) -> np.ndarray:
 def _window_means(planes: np.ndarray, targets: np.ndarray) -> np.ndarray:
     """(M, S, P, SIDE, SIDE) mean of each plane over each window cell; the part of a window
     beyond the map reads the plane's :data:`_OUTSIDE` value. Every plane value is a multiple
-    of 1/64, so the summed areas are exact and any order of summation gives the same means."""
+    of 1 / :data:`DISTANCE_SCALE` (a power of two), so the summed areas are exact and any order
+    of summation gives the same means."""
     height, width = planes.shape[1:]
     tables = _summed_areas(planes)  # (P, H + 1, W + 1)
     outside = _OUTSIDE[:, None, None, None]

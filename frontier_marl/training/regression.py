@@ -2,14 +2,13 @@
 
 The samples are grouped by decision into padded tensors (at most ``n_slots`` candidates, a
 mask for the rest). The target of each candidate is its relative regret
-(:func:`~frontier_marl.training.cost_to_go.relative_regret`; the ablation also tries the regret
-in cells over the map's side). The loss (:data:`LOSSES`) is the
-mean squared error over the valid candidates (``"regret"``: the shipped fit); the ablation
+(:func:`~frontier_marl.training.cost_to_go.relative_regret`). The shipped fit's loss is the
+mean squared error over the valid candidates (``"regret"`` of :data:`LOSSES`). The ablation
 (:mod:`~frontier_marl.experiments.explorer_studies.map_scorer_ablation`) also fits a listwise
-``"ranking"`` loss and ``"argmax"`` imitation of the cheapest candidate. Each batch is seen in
-one of the eight symmetries of the square (the crops rotated or mirrored, the target's row and
-column offsets turned alike), so the scorer learns that a corridor going north is a corridor
-going east.
+``"ranking"`` loss, ``"argmax"`` imitation of the cheapest candidate, and the regret in cells
+over the map's side. Each batch is seen in one of the eight symmetries of the square (the
+crops rotated or mirrored, the target's row and column offsets turned alike), so the scorer
+learns that a corridor going north is a corridor going east.
 """
 
 from __future__ import annotations

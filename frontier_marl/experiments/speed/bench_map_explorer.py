@@ -90,6 +90,8 @@ def measure(family_name: str, episodes: int, model_folder: Path | None) -> dict[
     finally:
         map_explorer.slot_crops = timer.original
     decisions, candidates, seconds = totals
+    if not decisions:
+        raise ValueError(f"{episodes} episodes of {family_name} had no decision among two slots")
     return {
         "family": family_name,
         "episodes": episodes,
