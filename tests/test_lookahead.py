@@ -118,8 +118,8 @@ def test_imitation_labels_real_decisions_and_fits_them() -> None:
 def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
     from frontier_marl import FrontierParallelEnv
     from frontier_marl.core.slots import SlotArrays
-    from frontier_marl.experiments.explorer_studies.rollout_probe import LinearScorerBase
     from frontier_marl.policies.linear_scorer import feature_names
+    from frontier_marl.policies.lookahead import LinearScorerBase
     from frontier_marl.policies.models import load_model
 
     cfg = load_model("explorer").env_config()

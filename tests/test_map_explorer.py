@@ -10,6 +10,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+import frontier_marl  # noqa: E402
 from frontier_marl.cli.main import main  # noqa: E402
 from frontier_marl.config import make_config  # noqa: E402
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN  # noqa: E402
@@ -20,7 +21,9 @@ from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (  # 
 )
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
-from frontier_marl.policies.linear_scorer import feature_names  # noqa: E402
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS  # noqa: E402
+from frontier_marl.policies.linear_scorer import feature_names, weight_vector  # noqa: E402
+from frontier_marl.policies.lookahead import LinearScorerBase, lookahead_costs  # noqa: E402
 from frontier_marl.policies.map_explorer import (  # noqa: E402
     MapExplorer,
     load_scorer,
@@ -28,10 +31,12 @@ from frontier_marl.policies.map_explorer import (  # noqa: E402
     save_map_explorer,
 )
 from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
+from frontier_marl.training import cost_regression  # noqa: E402
 from frontier_marl.training.cost_regression import scorer_config  # noqa: E402
 from frontier_marl.training.cost_to_go import (  # noqa: E402
     Samples,
     cells_regret,
+    decision_candidates,
     first_choice_of,
     label_episode,
     relative_regret,
@@ -132,6 +137,35 @@ def labelled() -> Samples:
     (world,) = map_families.variant_configs(fam, None, 1)
     nearest = first_choice_of(lambda obs, candidates: candidates.features[:, 0])
     return label_episode(scorer_config(world), fam.train[0], nearest, family="random-20")
+
+
+def test_labels_finished_by_frontier_rule_cost_what_its_rollouts_walk() -> None:
+    fam = map_families.family("rooms-32")
+    (world,) = map_families.variant_configs(fam, None, 1)
+    cfg = scorer_config(world)
+    task = ("rooms-32", int(fam.train[0]), None, 8, 0.5, 0)
+    by_rule = cost_regression._label((*task, "frontier-rule"))
+    by_nearest = cost_regression._label((*task, "nearest-path"))
+    np.testing.assert_array_equal(by_rule.decision, by_nearest.decision)  # same behaviour
+    assert not np.array_equal(by_rule.cost, by_nearest.cost)  # other finishers, other costs
+    env = frontier_marl.parallel_env(config=cfg)
+    observations, _ = env.reset(seed=int(fam.train[0]))
+    candidates = decision_candidates(env, observations["robot_0"])
+    while len(candidates.slots) < 2:
+        observations, *_ = env.step({"robot_0": int(candidates.slots[0])})
+        candidates = decision_candidates(env, observations["robot_0"])
+    targets = env.mdp.slot_tables()[0].target[candidates.slots]
+    world_now = env.world
+    rule = weight_vector(FRONTIER_RULE_WEIGHTS, feature_names(cfg), "frontier-rule")
+    costs = lookahead_costs(
+        world_now.batch,
+        world_now.index,
+        targets,
+        cfg.reward.explore_threshold,
+        4 * cfg.height * cfg.width,
+        LinearScorerBase(cfg, rule),
+    )
+    np.testing.assert_array_equal(by_rule.cost[by_rule.decision == 0], costs)
 
 
 def test_labels_give_every_candidate_of_a_decision_its_cost_to_go(labelled: Samples) -> None:
@@ -251,5 +285,7 @@ def test_a_bad_regression_section_is_named() -> None:
         load_experiment("explorer-map", ["regression.rounds=0"])
     with pytest.raises(ValueError, match=r"unknown \[regression\] key"):
         load_experiment("explorer-map", ["regression.epochs=3"])
+    with pytest.raises(ValueError, match="regression.finisher must be one of nearest-path, "):
+        load_experiment("explorer-map", ['regression.finisher="greedy-gain"'])
     with pytest.raises(ValueError, match="needs train.families and one robot"):
         load_experiment("explorer-map", ["train.families=[]"])

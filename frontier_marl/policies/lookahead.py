@@ -14,8 +14,9 @@ with its costs for a student that sees only its own observation.
 The base policy of the simulations keeps a target while it is still a frontier cell and then
 picks the next one: by default the nearest cluster by known-free path (ties: nearest
 centroid, :class:`NearestPathBase`), one cell per move; any :class:`RolloutBase` can take its
-place (:mod:`frontier_marl.experiments.explorer_studies.rollout_probe` finishes the
-simulations with the explorer).
+place: :class:`LinearScorerBase` finishes them with a linear slot scorer such as
+frontier-rule (:mod:`frontier_marl.experiments.explorer_studies.rollout_probe`, and the
+cost-to-go labels with ``regression.finisher = "frontier-rule"``).
 """
 
 from __future__ import annotations
@@ -24,12 +25,21 @@ from typing import Any
 
 import numpy as np
 
+from frontier_marl.config import EnvConfig
+from frontier_marl.core.slots import SlotArrays
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.policies.base import HeuristicPolicy, Info, first_by, slot_table
 from frontier_marl.sim.branching import branch
+from frontier_marl.sim.observations import ObservationEncoder
 from frontier_marl.sim.rollouts import NearestPathBase, RolloutBase, rollout_costs
 
-__all__ = ["LookaheadOracle", "NearestPathBase", "RolloutBase", "lookahead_costs"]
+__all__ = [
+    "LinearScorerBase",
+    "LookaheadOracle",
+    "NearestPathBase",
+    "RolloutBase",
+    "lookahead_costs",
+]
 
 
 def lookahead_costs(
@@ -54,6 +64,28 @@ def lookahead_costs(
     sims.goals[:, 0] = targets
     start = int(source.travelled[index, 0])
     return rollout_costs(sims, start, coverage, max_cells, base)
+
+
+class LinearScorerBase:
+    """A rollout base policy (:class:`~frontier_marl.policies.lookahead.RolloutBase`): the
+    linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own; the
+    simulations keep no heading, so the ``current`` feature reads 0)."""
+
+    def __init__(self, cfg: EnvConfig, weights: np.ndarray) -> None:
+        self.encoder = ObservationEncoder(cfg)
+        self.weights = weights
+        self.n_slots = cfg.n_slots
+        self.gain = cfg.gain
+
+    def goals(self, sims: Worlds, slots: SlotArrays, deciding: np.ndarray) -> np.ndarray:
+        rows = slots.rows(deciding)
+        positions = sims.positions[deciding, 0]
+        observed = self.encoder.encode_batch(rows, positions, beliefs=sims.belief[deciding])
+        scores = np.where(rows.valid, observed["slots"].astype(np.float64) @ self.weights, -np.inf)
+        best = np.argmax(scores, axis=1)
+        goals = rows.target[np.arange(len(deciding)), best].astype(np.int64)
+        goals[~rows.valid.any(axis=1)] = -1
+        return goals
 
 
 class LookaheadOracle(HeuristicPolicy):

@@ -6,8 +6,9 @@ Each round (``[regression]``, :class:`~frontier_marl.training.settings.Regressio
    family's training range) are played in the scorer's env (frontier-rule's observation on the
    family's world); round 0 follows frontier-rule, later rounds the scorer with the rule taking
    a ``rule_share`` of the decisions (DAgger). Every real decision is labelled with each
-   candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.cost_to_go`), in
-   ``label_workers`` processes; ``RUN/labels/round<r>.npz``;
+   candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.cost_to_go`; the
+   rollouts finished by ``finisher``), in ``label_workers`` processes;
+   ``RUN/labels/round<r>.npz``;
 2. **fit**: a new scorer on every label so far (:mod:`~frontier_marl.training.regression`);
 3. **validate**: the scorer and frontier-rule on the first ``train.validation_episodes``
    validation episodes of every family; the score is minus the mean per-episode relative T99
@@ -31,6 +32,7 @@ from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_fam
 from frontier_marl.evaluation.records import level_key
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
+from frontier_marl.policies.lookahead import LinearScorerBase
 from frontier_marl.policies.map_explorer import (
     MAP_EXPLORER_SETTINGS,
     MapExplorer,
@@ -128,7 +130,9 @@ def label_round(
 ) -> Samples:
     """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes
     (:func:`~frontier_marl.utils.parallel.map_tasks`)."""
-    tasks = [(name, ep, state, reg.scorer_width, reg.rule_share, seed) for name, ep in jobs]
+    tasks = [
+        (name, ep, state, reg.scorer_width, reg.rule_share, seed, reg.finisher) for name, ep in jobs
+    ]
     return Samples.join(map_tasks(_label, tasks, reg.label_workers, label=_label_name))
 
 
@@ -136,13 +140,13 @@ def _label_name(task: tuple[Any, ...]) -> str:
     return f"the labels of episode {task[1]} of {task[0]}"
 
 
-def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Samples:
-    name, episode, state, width, rule_share, seed = task
+def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str]) -> Samples:
+    name, episode, state, width, rule_share, seed, finisher = task
     torch.set_num_threads(1)
     (world,) = variant_configs(family(name), None, 1)
     cfg = scorer_config(world)
-    rule = weight_vector(FRONTIER_RULE_WEIGHTS, feature_names(cfg), "frontier-rule")
-    rule = rule.astype(np.float32)
+    weights = weight_vector(FRONTIER_RULE_WEIGHTS, feature_names(cfg), "frontier-rule")
+    rule = weights.astype(np.float32)
     model = None
     if state is not None:
         model = new_scorer(len(rule), width)
@@ -159,7 +163,8 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int]) -> Sam
             regret = model(crops, features, torch.ones((1, len(candidates.slots)), dtype=bool))
         return int(candidates.slots[int(torch.argmin(regret[0]))])
 
-    return label_episode(cfg, episode, behaviour, family=name)
+    base = LinearScorerBase(cfg, weights) if finisher == "frontier-rule" else None
+    return label_episode(cfg, episode, behaviour, base, family=name)
 
 
 def fitted(

@@ -235,6 +235,10 @@ class CEMSettings:
 CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
 
 
+#: The rollout finishers of the cost-to-go labels (``regression.finisher``).
+FINISHERS = ("nearest-path", "frontier-rule")
+
+
 @dataclass(frozen=True)
 class RegressionSettings:
     """The ``[regression]`` section: DAgger rounds of true-map labels and fits of the map
@@ -254,6 +258,9 @@ class RegressionSettings:
         rule_weights: the weights of frontier-rule's margin tried after each fit
             (:class:`~frontier_marl.policies.map_explorer.MapExplorer`); the best on the
             validation episodes is kept with the scorer.
+        finisher: the policy that finishes each labelled candidate's rollout on the true map
+            (:data:`FINISHERS`): ``nearest-path`` (compiled, the cheapest) or
+            ``frontier-rule`` (the cost-to-go a correction to the rule should predict).
     """
 
     rounds: int = 3
@@ -265,8 +272,13 @@ class RegressionSettings:
     scorer_width: int = 32
     rule_share: float = 0.5
     rule_weights: tuple[float, ...] = (0.0,)
+    finisher: str = "nearest-path"
 
     def __post_init__(self) -> None:
+        if self.finisher not in FINISHERS:
+            raise ValueError(
+                f"regression.finisher must be one of {', '.join(FINISHERS)}, got {self.finisher!r}"
+            )
         weights = self.rule_weights
         if (
             not isinstance(weights, tuple | list)

@@ -18,40 +18,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from frontier_marl.config import EnvConfig
-from frontier_marl.core.slots import SlotArrays
-from frontier_marl.core.worlds import Worlds
 from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
 from frontier_marl.evaluation.benchmark.run import Contender, contenders, model, run_benchmark
 from frontier_marl.evaluation.benchmark.stats import format_table
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
-from frontier_marl.policies.lookahead import LookaheadOracle
-from frontier_marl.sim.observations import ObservationEncoder
+from frontier_marl.policies.lookahead import LinearScorerBase, LookaheadOracle
 from frontier_marl.training.cem import shipped_weights
-
-
-class LinearScorerBase:
-    """A rollout base policy (:class:`~frontier_marl.policies.lookahead.RolloutBase`): the
-    linear slot scorer ``weights`` on the observation of ``cfg`` (the model's own; the
-    simulations keep no heading, so the ``current`` feature reads 0)."""
-
-    def __init__(self, cfg: EnvConfig, weights: np.ndarray) -> None:
-        self.encoder = ObservationEncoder(cfg)
-        self.weights = weights
-        self.n_slots = cfg.n_slots
-        self.gain = cfg.gain
-
-    def goals(self, sims: Worlds, slots: SlotArrays, deciding: np.ndarray) -> np.ndarray:
-        rows = slots.rows(deciding)
-        positions = sims.positions[deciding, 0]
-        observed = self.encoder.encode_batch(rows, positions, beliefs=sims.belief[deciding])
-        scores = np.where(rows.valid, observed["slots"].astype(np.float64) @ self.weights, -np.inf)
-        best = np.argmax(scores, axis=1)
-        goals = rows.target[np.arange(len(deciding)), best].astype(np.int64)
-        goals[~rows.valid.any(axis=1)] = -1
-        return goals
 
 
 class ExplorerRollout(LookaheadOracle):
