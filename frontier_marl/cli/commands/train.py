@@ -152,7 +152,8 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
         world = f"families {', '.join(settings.families)}, frontier-rule's observation"
         budget = (
             f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "
-            f"episodes per family, {reg.fit_epochs} epochs each, seed {settings.seed}"
+            f"episodes per family (rollouts finished by {reg.finisher}), {reg.fit_epochs} epochs "
+            f"each, seed {settings.seed}"
         )
     if settings.algorithm == "cem":
         cem = CEMSettings(**experiment.cem)
