@@ -8,7 +8,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from frontier_marl.core.frontiers import cluster_frontiers
+from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
+from frontier_marl.core.slots import robot_slots
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.evaluation.benchmark.families import family, variant_configs
 from frontier_marl.evaluation.benchmark.run import oracle, run_family
@@ -16,7 +21,7 @@ from frontier_marl.policies import lookahead
 from frontier_marl.sim.batch_engine import BatchMDP
 from frontier_marl.sim.branching import branch, branch_mdp
 from frontier_marl.sim.engine import ExplorationMDP
-from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
+from frontier_marl.sim.rollouts import NearestPathBase, nearest_path_goal, rollout_costs
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "environment.md"
 
@@ -94,6 +99,86 @@ def test_branch_mdp_needs_an_episode_in_progress() -> None:
     env = FrontierParallelEnv(preset="thesis-20x20")
     with pytest.raises(RuntimeError, match="episode in progress"):
         branch_mdp(env.mdp, 2)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    shape=st.tuples(st.integers(1, 14), st.integers(1, 14)),
+    seed=st.integers(0, 2**32 - 1),
+    unknown=st.floats(0.1, 0.6),
+    occupied=st.floats(0.0, 0.3),
+    connectivity=st.sampled_from([4, 8]),
+    max_cells=st.integers(0, 5),
+    n_slots=st.sampled_from([1, 2, 256]),
+)
+def test_the_rollouts_nearest_path_goal_is_the_slots_nearest_path(
+    shape, seed, unknown, occupied, connectivity, max_cells, n_slots
+) -> None:
+    """The compiled decision (union-find labelling, bounded search) against the slots built
+    from scipy's clusters: the live slot of shortest path, ties by centroid distance, then
+    slot; (-1, -1) when none is live."""
+    rng = np.random.default_rng(seed)
+    codes = np.array([UNKNOWN, FREE, OCCUPIED], dtype=np.int8)
+    belief = rng.choice(codes, size=shape, p=[unknown, 1 - unknown - occupied, occupied])
+    row, col = int(rng.integers(shape[0])), int(rng.integers(shape[1]))
+    belief[row, col] = FREE
+    clusters = cluster_frontiers(belief, connectivity, max_cells)
+    table = robot_slots(belief, (row, col), clusters, clusters.sizes.astype(float), n_slots, False)
+    expected = [-1, -1]
+    if table.live:
+        key = [(table.path_length[s], table.distance[s], s) for s in range(table.live)]
+        expected = table.target[min(key)[2]].tolist()
+    cells = belief.size
+    rows, cols, label, parent = (np.empty(cells, dtype=np.int64) for _ in range(4))
+    index = np.full(shape, -1, dtype=np.int64)
+    distance = np.full(cells, -1, dtype=np.int64)
+    goal = nearest_path_goal(
+        belief, row, col, connectivity, max_cells, n_slots, rows, cols, label, parent, index,
+        distance,
+    )  # fmt: skip
+    assert goal.tolist() == expected
+    assert (index == -1).all() and (distance == -1).all()  # the scratch is left as found
+
+
+class _SlotRoute:
+    """Nearest-path through the generic route: decision rounds, clusters labelled by
+    scipy.ndimage.label, the slots built by ``Worlds.slots``."""
+
+    n_slots = NearestPathBase.n_slots
+    gain = NearestPathBase.gain
+
+    def goals(self, sims, slots, deciding):  # type: ignore[no-untyped-def]
+        return NearestPathBase().goals(sims, slots, deciding)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"preset": "thesis-20x20"},
+        {"preset": "rooms-32", "connectivity": 4, "max_cluster_cells": 5},
+        {"preset": "rooms-32", "max_cluster_cells": 64, "sensor": "square"},
+    ],
+)
+@pytest.mark.parametrize("seed", [3, 11])
+def test_the_compiled_nearest_path_rollouts_walk_as_the_generic_route(kwargs, seed) -> None:
+    env = FrontierParallelEnv(**kwargs)
+    env.reset(seed=seed)
+    for choice in range(4):
+        (mask,) = env.mdp.action_masks()
+        env.mdp.step([_valid(mask, choice)])
+    world = env.world
+    slots = env.mdp.slot_arrays()
+    targets = slots.target[0, : int(slots.live[0])]
+    start = int(world.travelled[0])
+    runs = []
+    for base in (NearestPathBase(), _SlotRoute()):
+        sims = branch(world.batch, world.index, len(targets))
+        sims.goals[:, 0] = targets
+        cost = rollout_costs(sims, start, 0.99, 4 * world.belief.size, base)  # type: ignore[arg-type]
+        runs.append((cost, sims.belief.copy(), sims.positions.copy(), sims.travelled.copy()))
+    for fused, generic in zip(*runs, strict=True):
+        assert np.array_equal(fused, generic)
+    assert (runs[0][0] < 4 * world.belief.size).all()  # every rollout reached the coverage
 
 
 def test_clones_do_not_touch_their_source() -> None:

@@ -10,6 +10,7 @@ from scipy import ndimage
 
 from frontier_marl.core.frontiers import (
     cluster_frontiers,
+    label_frontier_cells,
     frontier_mask,
     split_cells,
     unknown_around,
@@ -384,6 +385,46 @@ def test_cluster_properties_on_random_beliefs(belief, connectivity, max_cells):
         assert any((cells == targets[k]).all(axis=1))
         d2 = ((cells - clusters.centroids[k]) ** 2).sum(axis=1)
         assert ((targets[k] - clusters.centroids[k]) ** 2).sum() == pytest.approx(d2.min())
+
+
+@settings(max_examples=200)
+@given(belief=beliefs, connectivity=st.sampled_from([4, 8]))
+def test_union_find_labelling_is_scipy_labelling(belief, connectivity):
+    """The rollouts' compiled labelling numbers the frontier exactly as scipy.ndimage.label
+    does (the design card's clustering), and leaves its scratch grid as it found it."""
+    structure = ndimage.generate_binary_structure(2, 1 if connectivity == 4 else 2)
+    expected, count = ndimage.label(frontier_mask(belief), structure=structure)
+    rows, cols, label, parent = (np.empty(belief.size, dtype=np.int64) for _ in range(4))
+    index = np.full(belief.shape, -1, dtype=np.int64)
+    cells, groups = label_frontier_cells(belief, connectivity, rows, cols, label, parent, index)
+    assert groups == count
+    assert cells == np.count_nonzero(expected)
+    np.testing.assert_array_equal(rows[:cells] * belief.shape[1] + cols[:cells],
+                                  np.flatnonzero(expected))  # fmt: skip
+    np.testing.assert_array_equal(label[:cells], expected[rows[:cells], cols[:cells]] - 1)
+    assert (index == -1).all()
+
+
+def test_union_find_labelling_joins_a_u_shape_in_raster_order():
+    """Two arms met only at the bottom: one group, whose cells all get the first arm's label,
+    then a later group numbered 1."""
+    belief = belief_from(
+        """
+        ? ? ? ? ? ?
+        . ? . ? . ?
+        . ? . ? . ?
+        . . . ? . ?
+        ? ? ? ? ? ?
+        """
+    )
+    n = belief.size
+    rows, cols, label, parent = (np.empty(n, dtype=np.int64) for _ in range(4))
+    index = np.full(belief.shape, -1, dtype=np.int64)
+    cells, groups = label_frontier_cells(belief, 4, rows, cols, label, parent, index)
+    assert groups == 2
+    by_cell = dict(zip(zip(rows[:cells].tolist(), cols[:cells].tolist()), label[:cells].tolist()))
+    assert by_cell[(1, 0)] == by_cell[(1, 2)] == by_cell[(3, 1)] == 0
+    assert by_cell[(1, 4)] == by_cell[(3, 4)] == 1
 
 
 @settings(max_examples=100)

@@ -315,3 +315,65 @@ def cluster_worlds(
         sizes[n, :clusters] = world_sizes
         centroids[n, :clusters] = world_centroids
         n_clusters[n] = clusters
+
+
+@compiled
+def label_frontier_cells(
+    belief: np.ndarray,
+    connectivity: int,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    label: np.ndarray,
+    parent: np.ndarray,
+    index: np.ndarray,
+) -> tuple[int, int]:
+    """The frontier cells of ``belief`` and their contiguous groups, labelled as
+    ``scipy.ndimage.label`` labels the frontier mask (``connectivity`` 4 or 8; groups numbered
+    from 0 in raster order of their first cell), by a union-find over the frontier cells alone.
+
+    Fills ``rows``/``cols`` (the cells, raster order) and ``label`` (0-based group per cell);
+    ``parent`` is scratch of at least as many entries, ``index`` an (H, W) int64 scratch grid
+    that must hold -1 everywhere and is left so. Returns (cells, groups)."""
+    height, width = belief.shape
+    n = 0
+    for r in range(height):
+        for c in range(width):
+            if not is_frontier(belief, r, c):
+                continue
+            rows[n] = r
+            cols[n] = c
+            index[r, c] = n
+            parent[n] = n
+            # Join the groups of the neighbours already scanned; a group's root is its
+            # first cell (the smaller root always wins).
+            for dr, dc in ((0, -1), (-1, -1), (-1, 0), (-1, 1)):
+                if connectivity == 4 and dr != 0 and dc != 0:
+                    continue
+                nr, nc = r + dr, c + dc
+                if nr >= 0 and 0 <= nc < width and index[nr, nc] >= 0:
+                    a = _root(parent, n)
+                    b = _root(parent, index[nr, nc])
+                    if a < b:
+                        parent[b] = a
+                    elif b < a:
+                        parent[a] = b
+            n += 1
+    groups = 0
+    for i in range(n):
+        root = _root(parent, i)
+        if root == i:
+            label[i] = groups
+            groups += 1
+        else:
+            label[i] = label[root]
+        index[rows[i], cols[i]] = -1
+    return n, groups
+
+
+@compiled
+def _root(parent: np.ndarray, i: int) -> int:
+    """The root of ``i`` in the union-find ``parent``, halving the path on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
