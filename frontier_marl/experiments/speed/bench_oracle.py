@@ -22,6 +22,7 @@ from typing import Any
 
 _CHILD = """
 import json, sys, time
+import frontier_marl
 from frontier_marl.evaluation.benchmark.families import family, variant_configs
 from frontier_marl.evaluation.benchmark.run import oracle, run_family
 fam = family(sys.argv[1])
@@ -31,16 +32,20 @@ start = time.perf_counter()
 result = run_family(fam, oracle(), configs, int(sys.argv[2]), split="validation")
 seconds = time.perf_counter() - start
 t99 = [e.cells_to_coverage["0.99"] for e in result.episodes]
-print(json.dumps({"seconds": seconds, "t99": t99}))
+print(json.dumps({"seconds": seconds, "t99": t99, "package": frontier_marl.__file__}))
 """
 
 
 def run_tree(tree: Path, family: str, episodes: int) -> dict[str, Any]:
-    """One timed run of the oracle in a fresh process importing ``tree``'s package."""
+    """One timed run of the oracle in a fresh process importing ``tree``'s package (run from
+    the tree: ``python -c`` puts its working folder first on the path)."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     args = [sys.executable, "-c", _CHILD, family, str(episodes)]
-    out = subprocess.run(args, env=env, check=True, capture_output=True, text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    done = subprocess.run(args, env=env, cwd=tree, check=True, capture_output=True, text=True)
+    report: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    if not Path(report.pop("package")).is_relative_to(tree):
+        raise RuntimeError(f"{tree}: the timed process imported another frontier_marl")
+    return report
 
 
 def main(argv: list[str] | None = None) -> int:
