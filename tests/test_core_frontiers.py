@@ -10,8 +10,8 @@ from scipy import ndimage
 
 from frontier_marl.core.frontiers import (
     cluster_frontiers,
-    label_frontier_cells,
     frontier_mask,
+    label_frontier_cells,
     split_cells,
     unknown_around,
 )
@@ -422,7 +422,8 @@ def test_union_find_labelling_joins_a_u_shape_in_raster_order():
     index = np.full(belief.shape, -1, dtype=np.int64)
     cells, groups = label_frontier_cells(belief, 4, rows, cols, label, parent, index)
     assert groups == 2
-    by_cell = dict(zip(zip(rows[:cells].tolist(), cols[:cells].tolist()), label[:cells].tolist()))
+    cells_at = zip(rows[:cells].tolist(), cols[:cells].tolist(), strict=True)
+    by_cell = dict(zip(cells_at, label[:cells].tolist(), strict=True))
     assert by_cell[(1, 0)] == by_cell[(1, 2)] == by_cell[(3, 1)] == 0
     assert by_cell[(1, 4)] == by_cell[(3, 4)] == 1
 
