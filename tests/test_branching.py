@@ -21,7 +21,8 @@ from frontier_marl.policies import lookahead
 from frontier_marl.sim.batch_engine import BatchMDP
 from frontier_marl.sim.branching import branch, branch_mdp
 from frontier_marl.sim.engine import ExplorationMDP
-from frontier_marl.sim.rollouts import NearestPathBase, nearest_path_goal, rollout_costs
+from frontier_marl.sim.nearest_path import DecisionScratch, nearest_path_goal
+from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "environment.md"
 
@@ -128,16 +129,10 @@ def test_the_rollouts_nearest_path_goal_is_the_slots_nearest_path(
     if table.live:
         key = [(table.path_length[s], table.distance[s], s) for s in range(table.live)]
         expected = table.target[min(key)[2]].tolist()
-    cells = belief.size
-    rows, cols, label, parent = (np.empty(cells, dtype=np.int64) for _ in range(4))
-    index = np.full(shape, -1, dtype=np.int64)
-    distance = np.full(cells, -1, dtype=np.int64)
-    goal = nearest_path_goal(
-        belief, row, col, connectivity, max_cells, n_slots, rows, cols, label, parent, index,
-        distance,
-    )  # fmt: skip
+    scratch = DecisionScratch(shape)
+    goal = nearest_path_goal(belief, row, col, connectivity, max_cells, n_slots, scratch.arrays())
     assert goal.tolist() == expected
-    assert (index == -1).all() and (distance == -1).all()  # the scratch is left as found
+    assert (scratch.owner == -1).all() and (scratch.distance == -1).all()  # left as found
 
 
 class _SlotRoute:
