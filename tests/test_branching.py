@@ -21,7 +21,7 @@ from frontier_marl.policies import lookahead
 from frontier_marl.sim.batch_engine import BatchMDP
 from frontier_marl.sim.branching import branch, branch_mdp
 from frontier_marl.sim.engine import ExplorationMDP
-from frontier_marl.sim.nearest_path import DecisionScratch, nearest_path_goal
+from frontier_marl.sim.nearest_path import DecisionScratch, nearest_path_goal, start_frontier
 from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "environment.md"
@@ -130,6 +130,7 @@ def test_the_rollouts_nearest_path_goal_is_the_slots_nearest_path(
         key = [(table.path_length[s], table.distance[s], s) for s in range(table.live)]
         expected = table.target[min(key)[2]].tolist()
     scratch = DecisionScratch(shape)
+    start_frontier(belief, scratch.arrays())
     goal = nearest_path_goal(belief, row, col, connectivity, max_cells, n_slots, scratch.arrays())
     assert goal.tolist() == expected
     assert (scratch.owner == -1).all() and (scratch.distance == -1).all()  # left as found

@@ -14,6 +14,7 @@ from frontier_marl.core.frontiers import (
     label_frontier_cells,
     split_cells,
     unknown_around,
+    update_frontier,
 )
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.slots import nearest_targets
@@ -396,13 +397,41 @@ def test_union_find_labelling_is_scipy_labelling(belief, connectivity):
     expected, count = ndimage.label(frontier_mask(belief), structure=structure)
     rows, cols, label, parent = (np.empty(belief.size, dtype=np.int64) for _ in range(4))
     index = np.full(belief.shape, -1, dtype=np.int64)
-    cells, groups = label_frontier_cells(belief, connectivity, rows, cols, label, parent, index)
+    mask = frontier_mask(belief)
+    cells, groups = label_frontier_cells(
+        mask, mask.sum(axis=1), connectivity, rows, cols, label, parent, index
+    )
     assert groups == count
     assert cells == np.count_nonzero(expected)
     np.testing.assert_array_equal(rows[:cells] * belief.shape[1] + cols[:cells],
                                   np.flatnonzero(expected))  # fmt: skip
     np.testing.assert_array_equal(label[:cells], expected[rows[:cells], cols[:cells]] - 1)
     assert (index == -1).all()
+
+
+@settings(max_examples=200)
+@given(
+    belief=beliefs,
+    seed=st.integers(0, 2**32 - 1),
+    changes=st.integers(1, 6),
+)
+def test_a_frontier_mask_updated_around_the_changes_is_the_mask_made_afresh(belief, seed, changes):
+    """Unknown cells become known (as sensing does) inside a box; updating the mask one cell
+    beyond the box gives the mask and row counts made from the whole grid."""
+    rng = np.random.default_rng(seed)
+    height, width = belief.shape
+    frontier = np.zeros(belief.shape, dtype=bool)
+    row_count = np.zeros(height, dtype=np.int64)
+    update_frontier(belief, frontier, row_count, 0, height, 0, width)
+    np.testing.assert_array_equal(frontier, frontier_mask(belief))
+    for _ in range(changes):
+        r0, c0 = int(rng.integers(height)), int(rng.integers(width))
+        r1, c1 = r0 + int(rng.integers(1, 4)), c0 + int(rng.integers(1, 4))
+        box = belief[r0:r1, c0:c1]
+        box[box == UNKNOWN] = rng.choice([FREE, OCCUPIED], size=int((box == UNKNOWN).sum()))
+        update_frontier(belief, frontier, row_count, r0 - 1, r1 + 1, c0 - 1, c1 + 1)
+        np.testing.assert_array_equal(frontier, frontier_mask(belief))
+        np.testing.assert_array_equal(row_count, frontier_mask(belief).sum(axis=1))
 
 
 def test_union_find_labelling_joins_a_u_shape_in_raster_order():
@@ -420,7 +449,10 @@ def test_union_find_labelling_joins_a_u_shape_in_raster_order():
     n = belief.size
     rows, cols, label, parent = (np.empty(n, dtype=np.int64) for _ in range(4))
     index = np.full(belief.shape, -1, dtype=np.int64)
-    cells, groups = label_frontier_cells(belief, 4, rows, cols, label, parent, index)
+    mask = frontier_mask(belief)
+    cells, groups = label_frontier_cells(
+        mask, mask.sum(axis=1), 4, rows, cols, label, parent, index
+    )
     assert groups == 2
     cells_at = zip(rows[:cells].tolist(), cols[:cells].tolist(), strict=True)
     by_cell = dict(zip(cells_at, label[:cells].tolist(), strict=True))

@@ -3,10 +3,22 @@ against a plain BFS oracle on random maps."""
 
 from __future__ import annotations
 
+import heapq
+import math
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from frontier_marl.core.planning import astar, distance_field, distance_fields
+from frontier_marl.core.planning import (
+    UNSEEN,
+    astar,
+    astar_into,
+    distance_field,
+    distance_fields,
+    path_search_scratch,
+)
 from tests import oracles
 
 
@@ -194,3 +206,57 @@ def test_distance_fields_stack_one_field_per_source():
 def test_distance_field_on_a_belief_uses_free_cells_only():
     belief = np.array([[0, 0, -1, 0], [1, 0, 0, 0]], dtype=np.int8)
     np.testing.assert_array_equal(distance_field(belief, 0, 0, 0), [[0, 1, -1, 5], [-1, 2, 3, 4]])
+
+
+def _heapq_astar(passable, start, goal):
+    """The planner's search written with Python's heapq: nodes leave in order of
+    (f, -g, cell), f = g + the Euclidean distance to the goal."""
+    height, width = passable.shape
+    (s_row, s_col), (g_row, g_col) = start, goal
+    if not passable[g_row, g_col]:
+        return None
+    source, target = s_row * width + s_col, g_row * width + g_col
+    cost, parent = {source: 0}, {}
+    heap = [(math.hypot(s_row - g_row, s_col - g_col), 0, source)]
+    while heap:
+        _, neg_g, cell = heapq.heappop(heap)
+        if cell == target:
+            path = [cell]
+            while path[-1] != source:
+                path.append(parent[path[-1]])
+            return np.array([divmod(c, width) for c in reversed(path)])
+        g = -neg_g
+        if g > cost[cell]:
+            continue
+        row, col = divmod(cell, width)
+        for n_row, n_col in ((row - 1, col), (row + 1, col), (row, col - 1), (row, col + 1)):
+            if 0 <= n_row < height and 0 <= n_col < width and passable[n_row, n_col]:
+                neighbour = n_row * width + n_col
+                if g + 1 < cost.get(neighbour, 1 << 60):
+                    cost[neighbour], parent[neighbour] = g + 1, cell
+                    f = g + 1 + math.sqrt((n_row - g_row) ** 2 + (n_col - g_col) ** 2)
+                    heapq.heappush(heap, (f, -(g + 1), neighbour))
+    return None
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    shape=st.tuples(st.integers(1, 14), st.integers(1, 14)),
+    density=st.floats(0.0, 0.45),
+)
+def test_astar_takes_the_same_path_as_a_heapq_search(seed, shape, density):
+    """Same cells, not only the same length: the walk and the plan cache depend on which
+    shortest path is taken. The compiled search keeps its buffers between calls."""
+    rng = np.random.default_rng(seed)
+    passable = rng.random(shape) >= density
+    scratch, out = path_search_scratch(shape), np.empty((passable.size, 2), dtype=np.int64)
+    cells = [tuple(int(x) for x in rng.integers(0, shape)) for _ in range(6)]
+    for start, goal in zip(cells[:-1], cells[1:], strict=True):
+        expected = _heapq_astar(passable, start, goal)
+        length = astar_into(passable, True, *start, *goal, out, scratch)
+        if expected is None:
+            assert length == 0
+        else:
+            np.testing.assert_array_equal(out[:length], expected)
+        assert (scratch[0] == UNSEEN).all()  # left as found

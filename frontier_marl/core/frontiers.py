@@ -318,8 +318,37 @@ def cluster_worlds(
 
 
 @compiled
-def label_frontier_cells(
+def update_frontier(
     belief: np.ndarray,
+    frontier: np.ndarray,
+    row_count: np.ndarray,
+    r0: int,
+    r1: int,
+    c0: int,
+    c1: int,
+) -> None:
+    """Bring the frontier mask ``frontier`` (bool, (H, W)) and its per-row counts
+    ``row_count`` (H,) up to date with ``belief`` inside rows ``r0:r1`` and columns ``c0:c1``
+    (clipped to the grid). A belief change at a cell can only change the frontier at that cell
+    and its 4-neighbours, so a window one cell wider than the changes keeps the whole mask
+    exact; the whole grid's window makes it from scratch."""
+    height, width = belief.shape
+    for r in range(max(r0, 0), min(r1, height)):
+        for c in range(max(c0, 0), min(c1, width)):
+            # (as a branch: numba compiles ``is_frontier`` used as a value about 20x slower)
+            if is_frontier(belief, r, c):
+                if not frontier[r, c]:
+                    frontier[r, c] = True
+                    row_count[r] += 1
+            elif frontier[r, c]:
+                frontier[r, c] = False
+                row_count[r] -= 1
+
+
+@compiled
+def label_frontier_cells(
+    frontier: np.ndarray,
+    row_count: np.ndarray,
     connectivity: int,
     rows: np.ndarray,
     cols: np.ndarray,
@@ -327,18 +356,22 @@ def label_frontier_cells(
     parent: np.ndarray,
     index: np.ndarray,
 ) -> tuple[int, int]:
-    """The frontier cells of ``belief`` and their contiguous groups, labelled as
-    ``scipy.ndimage.label`` labels the frontier mask (``connectivity`` 4 or 8; groups numbered
-    from 0 in raster order of their first cell), by a union-find over the frontier cells alone.
+    """The cells of the frontier mask ``frontier`` (with its per-row counts ``row_count``, as
+    :func:`update_frontier` keeps them) and their contiguous groups, labelled as
+    ``scipy.ndimage.label`` labels the mask (``connectivity`` 4 or 8; groups numbered from 0
+    in raster order of their first cell), by a union-find over the frontier cells alone; rows
+    without frontier cells are skipped.
 
     Fills ``rows``/``cols`` (the cells, raster order) and ``label`` (0-based group per cell);
     ``parent`` is scratch of at least as many entries, ``index`` an (H, W) int64 scratch grid
     that must hold -1 everywhere and is left so. Returns (cells, groups)."""
-    height, width = belief.shape
+    height, width = frontier.shape
     n = 0
     for r in range(height):
+        if row_count[r] == 0:
+            continue
         for c in range(width):
-            if not is_frontier(belief, r, c):
+            if not frontier[r, c]:
                 continue
             rows[n] = r
             cols[n] = c

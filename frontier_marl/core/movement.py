@@ -20,7 +20,7 @@ import numpy as np
 
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import FREE
-from frontier_marl.core.planning import astar_path
+from frontier_marl.core.planning import astar_into
 from frontier_marl.core.sensing import reveal
 
 
@@ -42,6 +42,7 @@ def walk(
     walked: np.ndarray,
     walked_len: np.ndarray,
     reached: np.ndarray,
+    search: tuple,
 ) -> int:
     """``World.move`` (see the module docstring); returns the new belief version.
 
@@ -51,7 +52,8 @@ def walk(
     ``goals[a]`` is robot a's target, row -1 to stay; ``cells_per_step`` is -1 for the whole
     path. Sensing is :func:`reveal` with ``offsets``/``between``. Outputs:
     ``new_cells`` (N,), ``walked[a, :walked_len[a]]`` (the cells robot a occupied, start
-    included) and ``reached`` (N,).
+    included) and ``reached`` (N,). ``search``: the planner's scratch
+    (:func:`~frontier_marl.core.planning.path_search_scratch`).
     """
     n = positions.shape[0]
     first = np.zeros(n, dtype=np.int64)  # index in plans[a] of the next cell to enter
@@ -79,15 +81,14 @@ def walk(
             and plans[a, start, 1] == col
         )
         if not cached:
-            path = astar_path(belief, FREE, row, col, goal_row, goal_col)
-            if len(path) == 0:
+            length = astar_into(belief, FREE, row, col, goal_row, goal_col, plans[a], search)
+            if length == 0:
                 plan_meta[a, 4] = -1
                 continue
-            plans[a, : len(path)] = path
             plan_meta[a, 0] = goal_row
             plan_meta[a, 1] = goal_col
             plan_meta[a, 2] = 0
-            plan_meta[a, 3] = len(path)
+            plan_meta[a, 3] = length
             plan_meta[a, 4] = version
             start = 0
         path_length[a] = plan_meta[a, 3] - start - 1

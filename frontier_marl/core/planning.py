@@ -12,7 +12,6 @@ grid with ``free=FREE``.
 
 from __future__ import annotations
 
-import heapq
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -76,43 +75,88 @@ def _euclid(d_row: int, d_col: int) -> float:
     return math.sqrt(d_row * d_row + d_col * d_col)
 
 
-@compiled
+UNSEEN = 1 << 60  # the cost of a cell the search has not reached
+
+
+def path_search_scratch(shape: tuple[int, int]) -> tuple[np.ndarray, ...]:
+    """The reusable buffers of :func:`astar_into` for grids of ``shape``: per cell its cost
+    (all :data:`UNSEEN` between searches), parent and the list of cells a search touched, and
+    a binary heap (f, -g, cell) with room for every push a search can make."""
+    cells = shape[0] * shape[1]
+    pushes = 4 * cells + 1  # a push per relaxed edge, and the source
+    return (
+        np.full(cells, UNSEEN, dtype=np.int64),
+        np.empty(cells, dtype=np.int64),
+        np.empty(cells, dtype=np.int64),
+        np.empty(pushes, dtype=np.float64),
+        np.empty(pushes, dtype=np.int64),
+        np.empty(pushes, dtype=np.int64),
+    )
+
+
 def astar_path(
     grid: np.ndarray, free: Any, s_row: int, s_col: int, g_row: int, g_col: int
 ) -> np.ndarray:
-    """:func:`astar` on the cells where ``grid == free``; (0, 2) if the goal is unreachable.
+    """:func:`astar` on the cells where ``grid == free``; (0, 2) if the goal is unreachable."""
+    out = np.empty((grid.size, 2), dtype=np.int64)
+    length = astar_into(
+        grid, free, s_row, s_col, g_row, g_col, out, path_search_scratch(grid.shape)
+    )
+    return out[:length].copy()
 
-    Among equal f the deeper node is expanded first (fewer expansions); ties keep push order.
+
+@compiled
+def astar_into(
+    grid: np.ndarray,
+    free: Any,
+    s_row: int,
+    s_col: int,
+    g_row: int,
+    g_col: int,
+    out: np.ndarray,
+    scratch: tuple,
+) -> int:
+    """:func:`astar` on the cells where ``grid == free``, written to ``out[:length]`` (the
+    cells from start to goal); returns ``length``, 0 if the goal is unreachable. ``scratch``:
+    :func:`path_search_scratch` of the grid's shape, left as found.
+
+    Nodes leave the heap in order of (f, -g, cell): among equal f the deeper node first (fewer
+    expansions), then the lower cell index.
     """
     height, width = grid.shape
     if not (0 <= g_row < height and 0 <= g_col < width) or grid[g_row, g_col] != free:
-        return np.empty((0, 2), dtype=np.int64)
+        return 0
     source = s_row * width + s_col
     target = g_row * width + g_col
     if source == target:
-        path = np.empty((1, 2), dtype=np.int64)
-        path[0, 0] = s_row
-        path[0, 1] = s_col
-        return path
-    cost = np.full(height * width, 1 << 60, dtype=np.int64)
-    parent = np.full(height * width, -1, dtype=np.int64)
+        out[0, 0] = s_row
+        out[0, 1] = s_col
+        return 1
+    cost, parent, touched, heap_f, heap_g, heap_cell = scratch
     cost[source] = 0
-    heap = [(_euclid(s_row - g_row, s_col - g_col), 0, source)]
-    while heap:
-        _, neg_g, cell = heapq.heappop(heap)
+    touched[0] = source
+    n_touched = 1
+    heap_f[0] = _euclid(s_row - g_row, s_col - g_col)
+    heap_g[0] = 0
+    heap_cell[0] = source
+    size = 1
+    length = 0
+    while size > 0:
+        neg_g, cell = heap_g[0], heap_cell[0]
+        size -= 1
+        _sift_down(heap_f, heap_g, heap_cell, size)
         if cell == target:
             length = 1
             walk = target
             while walk != source:
                 walk = parent[walk]
                 length += 1
-            path = np.empty((length, 2), dtype=np.int64)
             walk = target
             for i in range(length - 1, -1, -1):
-                path[i, 0] = walk // width
-                path[i, 1] = walk % width
+                out[i, 0] = walk // width
+                out[i, 1] = walk % width
                 walk = parent[walk]
-            return path
+            break
         g = -neg_g
         if g > cost[cell]:
             continue
@@ -123,8 +167,65 @@ def astar_path(
                 continue
             neighbour = n_row * width + n_col
             if g_next < cost[neighbour]:
+                if cost[neighbour] == UNSEEN:
+                    touched[n_touched] = neighbour
+                    n_touched += 1
                 cost[neighbour] = g_next
                 parent[neighbour] = cell
                 f = g_next + _euclid(n_row - g_row, n_col - g_col)
-                heapq.heappush(heap, (f, -g_next, neighbour))
-    return np.empty((0, 2), dtype=np.int64)
+                _push(heap_f, heap_g, heap_cell, size, f, -g_next, neighbour)
+                size += 1
+    for i in range(n_touched):
+        cost[touched[i]] = UNSEEN
+    return length
+
+
+@compiled
+def _before(f: float, g: int, cell: int, f2: float, g2: int, cell2: int) -> bool:
+    """(f, g, cell) < (f2, g2, cell2), as tuples compare."""
+    if f != f2:
+        return f < f2
+    if g != g2:
+        return g < g2
+    return cell < cell2
+
+
+@compiled
+def _push(
+    heap_f: np.ndarray, heap_g: np.ndarray, heap_cell: np.ndarray, size: int,
+    f: float, g: int, cell: int,
+) -> None:  # fmt: skip
+    """Add (f, g, cell) to the heap of ``size`` entries."""
+    i = size
+    while i > 0:
+        up = (i - 1) >> 1
+        if not _before(f, g, cell, heap_f[up], heap_g[up], heap_cell[up]):
+            break
+        heap_f[i], heap_g[i], heap_cell[i] = heap_f[up], heap_g[up], heap_cell[up]
+        i = up
+    heap_f[i], heap_g[i], heap_cell[i] = f, g, cell
+
+
+@compiled
+def _sift_down(heap_f: np.ndarray, heap_g: np.ndarray, heap_cell: np.ndarray, size: int) -> None:
+    """After the top was taken: move the last entry (now at ``size``) down from the top of the
+    heap of ``size`` entries."""
+    if size == 0:
+        return
+    f, g, cell = heap_f[size], heap_g[size], heap_cell[size]
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= size:
+            break
+        right = child + 1
+        if right < size and _before(
+            heap_f[right], heap_g[right], heap_cell[right],
+            heap_f[child], heap_g[child], heap_cell[child],
+        ):  # fmt: skip
+            child = right
+        if not _before(heap_f[child], heap_g[child], heap_cell[child], f, g, cell):
+            break
+        heap_f[i], heap_g[i], heap_cell[i] = heap_f[child], heap_g[child], heap_cell[child]
+        i = child
+    heap_f[i], heap_g[i], heap_cell[i] = f, g, cell

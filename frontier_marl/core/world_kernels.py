@@ -31,8 +31,10 @@ def walk_worlds(
     walked: np.ndarray,
     walked_len: np.ndarray,
     reached: np.ndarray,
+    search: tuple,
 ) -> None:
-    """:func:`~frontier_marl.core.movement.walk` for every active world."""
+    """:func:`~frontier_marl.core.movement.walk` for every active world (``search``: the
+    planner's scratch, shared by the worlds)."""
     for n in range(len(active)):
         if not active[n]:
             continue
@@ -53,6 +55,7 @@ def walk_worlds(
             walked[n],
             walked_len[n],
             reached[n],
+            search,
         )
 
 

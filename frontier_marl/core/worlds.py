@@ -27,6 +27,7 @@ from frontier_marl.core.frontiers import (
 )
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
+from frontier_marl.core.planning import path_search_scratch
 from frontier_marl.core.sensing import Sensor, reveal
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays
 from frontier_marl.core.world_kernels import all_slots, count_known, settle_clusters, walk_worlds
@@ -76,6 +77,7 @@ class Worlds:
         self.walked = np.zeros((n, k, walk_cells, 2), dtype=np.int64)
         self.walked_len = np.zeros((n, k), dtype=np.int64)
         self.reached = np.zeros((n, k), dtype=bool)
+        self.search = path_search_scratch((height, width))  # the planner's, for every world
         # Frontier clusters per world, cells and clusters in raster order (capacity: all cells).
         self.cell_rows = np.zeros((n, cells), dtype=np.int64)
         self.cell_cols = np.zeros((n, cells), dtype=np.int64)
@@ -160,6 +162,7 @@ class Worlds:
             self.walked,
             self.walked_len,
             self.reached,
+            self.search,
         )
 
     # ----------------------------------------------------------------- frontier view

@@ -5,9 +5,11 @@
 :meth:`~frontier_marl.core.worlds.Worlds.refresh_clusters` makes them, but labelled by a
 union-find over the frontier cells alone
 (:func:`~frontier_marl.core.frontiers.label_frontier_cells`, numbered as ``scipy.ndimage.label``
-numbers them), and finds the slot nearest by path with a breadth-first search that stops as soon
-as the answer is sure; when it cannot be, it builds the slots as the env does
-(:func:`~frontier_marl.core.slots._robot_slots`) and takes :func:`nearest_path` of them.
+numbers them) from a frontier mask the caller keeps up to date where the belief changed
+(:func:`~frontier_marl.core.frontiers.update_frontier`), and finds the slot nearest by path with
+a breadth-first search that stops as soon as the answer is sure; when it cannot be, it builds
+the slots as the env does (:func:`~frontier_marl.core.slots._robot_slots`) and takes
+:func:`nearest_path` of them.
 """
 
 from __future__ import annotations
@@ -15,25 +17,45 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.frontiers import cluster_stats, label_frontier_cells, split_and_renumber
+from frontier_marl.core.frontiers import (
+    cluster_stats,
+    label_frontier_cells,
+    split_and_renumber,
+    update_frontier,
+)
 from frontier_marl.core.grid import FREE
 from frontier_marl.core.slots import _robot_slots, nearest_targets
 
 
 class DecisionScratch:
     """The scratch of :func:`nearest_path_goal` for grids of ``shape``, made once per batch
-    of rollouts: four int64 buffers of a cell each, and an (H, W) grid and a flat buffer
-    that hold -1 between calls."""
+    of rollouts: four int64 buffers of a cell each, an (H, W) grid and a flat buffer that
+    hold -1 between calls, and the frontier mask of the world being decided with its
+    per-row counts (:func:`start_frontier`, then
+    :func:`~frontier_marl.core.frontiers.update_frontier` where its belief changed)."""
 
     def __init__(self, shape: tuple[int, int]) -> None:
         cells = shape[0] * shape[1]
         self.buffers = tuple(np.empty(cells, dtype=np.int64) for _ in range(4))
         self.owner = np.full(shape, -1, dtype=np.int64)
         self.distance = np.full(cells, -1, dtype=np.int64)
+        self.frontier = np.zeros(shape, dtype=np.bool_)
+        self.row_count = np.zeros(shape[0], dtype=np.int64)
 
     def arrays(self) -> tuple[np.ndarray, ...]:
-        """(rows, cols, label, parent, owner grid, distance), in that order."""
-        return (*self.buffers, self.owner, self.distance)
+        """(rows, cols, label, parent, owner grid, distance, frontier, row counts), in that
+        order."""
+        return (*self.buffers, self.owner, self.distance, self.frontier, self.row_count)
+
+
+@compiled
+def start_frontier(belief: np.ndarray, scratch: tuple) -> None:
+    """Make the frontier mask of ``scratch`` (:meth:`DecisionScratch.arrays`) that of
+    ``belief``, from scratch."""
+    frontier, row_count = scratch[6], scratch[7]
+    frontier[:] = False
+    row_count[:] = 0
+    update_frontier(belief, frontier, row_count, 0, belief.shape[0], 0, belief.shape[1])
 
 
 @compiled
@@ -73,9 +95,11 @@ def nearest_path_goal(
     frontier clusters as :meth:`Worlds.refresh_clusters` makes them (labelled by
     :func:`~frontier_marl.core.frontiers.label_frontier_cells`, split above
     ``max_cluster_cells``), its slots, the nearest by path; (-1, -1) if none is live.
-    ``scratch``: :meth:`DecisionScratch.arrays`."""
-    rows, cols, label, parent, index, distance = scratch
-    cells, count = label_frontier_cells(belief, connectivity, rows, cols, label, parent, index)
+    ``scratch``: :meth:`DecisionScratch.arrays`, its frontier mask that of ``belief``."""
+    rows, cols, label, parent, index, distance, frontier, row_count = scratch
+    cells, count = label_frontier_cells(
+        frontier, row_count, connectivity, rows, cols, label, parent, index
+    )
     cell_rows, cell_cols, cluster = rows[:cells], cols[:cells], label[:cells]
     if max_cluster_cells > 0 and cells > 0:
         cluster, count = split_and_renumber(

@@ -25,12 +25,17 @@ from typing import Protocol
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.frontiers import is_frontier
+from frontier_marl.core.frontiers import is_frontier, update_frontier
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slots import SlotArrays
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.sim.nearest_path import DecisionScratch, nearest_path, nearest_path_goal
+from frontier_marl.sim.nearest_path import (
+    DecisionScratch,
+    nearest_path,
+    nearest_path_goal,
+    start_frontier,
+)
 
 ROLLOUT_SLOTS = 256  # the base policy sees every reachable cluster, as the heuristics do
 
@@ -93,8 +98,10 @@ def rollout_costs(
 
 
 class _RolloutState:
-    """Per world: ended, has a new target to walk toward first, its cost, and an upper bound
-    on its known cells of the region (``known``; ``exact`` when it is the count itself). The
+    """Per world: ended, has a new target to walk toward first, its cost, an upper bound on
+    its known cells of the region (``known``; ``exact`` when it is the count itself), and the
+    box of the cells its robots sensed from since it was last cleared (``sensed``: first row,
+    last row, first column, last column; empty while the first row is above the last). The
     bound grows by the cells each walk reveals, and the belief is counted only when the bound
     reaches the coverage level."""
 
@@ -106,10 +113,12 @@ class _RolloutState:
         self.known = sims.start_region_size.copy()  # the region itself: a bound that holds
         self.exact = np.zeros(n, dtype=bool)
         self.deciding = np.zeros(n, dtype=bool)  # the worlds :func:`advance` left deciding
+        self.sensed = np.zeros((n, 4), dtype=np.int64)
+        self.sensed[:, 0] = 1  # empty
 
     def arrays(self) -> tuple[np.ndarray, ...]:
         """The per-world arrays :func:`advance_world` reads and writes, in its order."""
-        return self.done, self.pending, self.cost, self.known, self.exact
+        return self.done, self.pending, self.cost, self.known, self.exact, self.sensed
 
 
 def _world_arrays(sims: Worlds) -> tuple[object, ...]:
@@ -119,7 +128,7 @@ def _world_arrays(sims: Worlds) -> tuple[object, ...]:
         sims.start_region, sims.start_region_size, sims.true, sims.belief, sims.seen,
         sims.positions, sims.travelled, sims.goals, sims.plan_cells, sims.plan_meta,
         sims.version, sims.params.cells_per_step, offsets, between, sims.new_cells,
-        sims.walked, sims.walked_len, sims.reached,
+        sims.walked, sims.walked_len, sims.reached, sims.search,
     )  # fmt: skip
 
 
@@ -132,9 +141,10 @@ def _rollout_nearest_path(
 ) -> None:
     params = sims.params
     scratch = DecisionScratch(sims.shape)
+    reach = int(np.abs(params.sensor.rays[0]).max(initial=0))  # a sensed cell's farthest change
     rollout_nearest_path(
         state.arrays(), _world_arrays(sims), start, coverage, cap, params.connectivity,
-        params.max_cluster_cells, n_slots, scratch.arrays(),
+        params.max_cluster_cells, n_slots, reach, scratch.arrays(),
     )  # fmt: skip
 
 
@@ -158,11 +168,11 @@ def advance_world(
     (coverage reached: ``cost`` is its walk; ``max_cells`` walked; ``done`` set) or its goal is
     no longer a frontier cell or is reached (returns True: it needs a decision). ``state``:
     :meth:`_RolloutState.arrays`; ``world``: :func:`_world_arrays`."""
-    done, pending, cost, known, exact = state
+    done, pending, cost, known, exact, sensed = state
     (
         region, region_size, true, belief, seen, positions, travelled, goals, plan_cells,
         plan_meta, version, cells_per_step, offsets, between, new_cells, walked, walked_len,
-        reached,
+        reached, search,
     ) = world  # fmt: skip
     moving = pending[n]
     pending[n] = False
@@ -171,12 +181,13 @@ def advance_world(
             version[n] = walk(
                 true[n], belief[n], seen[n], positions[n], travelled[n], goals[n],
                 plan_cells[n], plan_meta[n], version[n], cells_per_step, offsets, between,
-                new_cells[n], walked[n], walked_len[n], reached[n],
+                new_cells[n], walked[n], walked_len[n], reached[n], search,
             )  # fmt: skip
             revealed = new_cells[n].sum()
             if revealed:
                 known[n] += revealed
                 exact[n] = False
+                _add_sensed(sensed[n], walked[n], walked_len[n])
         moving = True
         size = max(region_size[n], 1)
         if not exact[n] and known[n] / size >= coverage:  # the bound says maybe: count
@@ -204,16 +215,31 @@ def rollout_nearest_path(
     connectivity: int,
     max_cluster_cells: int,
     n_slots: int,
+    reach: int,
     scratch: tuple,
 ) -> None:
     """Every world rolled out to its end with :class:`NearestPathBase` deciding, world after
-    world (the worlds are independent); ``scratch``: :meth:`DecisionScratch.arrays`."""
-    done, pending = state[0], state[1]
+    world (the worlds are independent); ``scratch``: :meth:`DecisionScratch.arrays`. The
+    frontier mask is made once per world, then brought up to date before each decision
+    within ``reach`` + 1 cells of where the robots sensed (``reach``: the sensor's farthest
+    offset)."""
+    done, pending, sensed = state[0], state[1], state[5]
     belief, positions, goals = world[3], world[5], world[7]
+    frontier, row_count = scratch[6], scratch[7]
+    margin = reach + 1
     for n in range(len(done)):
+        start_frontier(belief[n], scratch)
+        sensed[n, 0], sensed[n, 1] = 1, 0
         while not done[n]:
             if not advance_world(n, state, world, start, coverage, max_cells):
                 continue
+            box = sensed[n]
+            if box[0] <= box[1]:
+                update_frontier(
+                    belief[n], frontier, row_count, box[0] - margin, box[1] + margin + 1,
+                    box[2] - margin, box[3] + margin + 1,
+                )  # fmt: skip
+                box[0], box[1] = 1, 0
             goal = nearest_path_goal(
                 belief[n], positions[n, 0, 0], positions[n, 0, 1], connectivity,
                 max_cluster_cells, n_slots, scratch,
@@ -224,6 +250,20 @@ def rollout_nearest_path(
                 goals[n, 0, 0] = goal[0]
                 goals[n, 0, 1] = goal[1]
                 pending[n] = True
+
+
+@compiled
+def _add_sensed(box: np.ndarray, walked: np.ndarray, walked_len: np.ndarray) -> None:
+    """Grow the box (first row, last row, first column, last column; empty while the first
+    row is above the last) over the cells each robot entered in a walk (``walked[a, 1:]``)."""
+    for a in range(len(walked_len)):
+        for i in range(1, walked_len[a]):
+            r, c = walked[a, i, 0], walked[a, i, 1]
+            if box[0] > box[1]:
+                box[0], box[1], box[2], box[3] = r, r, c, c
+            else:
+                box[0], box[1] = min(box[0], r), max(box[1], r)
+                box[2], box[3] = min(box[2], c), max(box[3], c)
 
 
 @compiled
