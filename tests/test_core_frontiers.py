@@ -8,13 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
 
+from frontier_marl.core.frontier_union import label_frontier_cells, update_frontier
 from frontier_marl.core.frontiers import (
     cluster_frontiers,
     frontier_mask,
-    label_frontier_cells,
     split_cells,
     unknown_around,
-    update_frontier,
 )
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.slots import nearest_targets

@@ -33,8 +33,12 @@ def astar(passable: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -
         is unreachable (or not passable).
     """
     passable = np.asarray(passable, dtype=bool)
-    path = astar_path(passable, True, int(start[0]), int(start[1]), int(goal[0]), int(goal[1]))
-    return path if len(path) else None
+    out = np.empty((passable.size, 2), dtype=np.int64)
+    length = astar_into(
+        passable, True, int(start[0]), int(start[1]), int(goal[0]), int(goal[1]), out,
+        path_search_scratch(passable.shape),
+    )  # fmt: skip
+    return out[:length].copy() if length else None
 
 
 def distance_fields(passable: np.ndarray, sources: Sequence[tuple[int, int]]) -> np.ndarray:
@@ -92,17 +96,6 @@ def path_search_scratch(shape: tuple[int, int]) -> tuple[np.ndarray, ...]:
         np.empty(pushes, dtype=np.int64),
         np.empty(pushes, dtype=np.int64),
     )
-
-
-def astar_path(
-    grid: np.ndarray, free: Any, s_row: int, s_col: int, g_row: int, g_col: int
-) -> np.ndarray:
-    """:func:`astar` on the cells where ``grid == free``; (0, 2) if the goal is unreachable."""
-    out = np.empty((grid.size, 2), dtype=np.int64)
-    length = astar_into(
-        grid, free, s_row, s_col, g_row, g_col, out, path_search_scratch(grid.shape)
-    )
-    return out[:length].copy()
 
 
 @compiled

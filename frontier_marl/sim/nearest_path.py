@@ -3,11 +3,10 @@
 
 :func:`nearest_path_goal` makes the robot's frontier clusters as
 :meth:`~frontier_marl.core.worlds.Worlds.refresh_clusters` makes them, but labelled by a
-union-find over the frontier cells alone
-(:func:`~frontier_marl.core.frontiers.label_frontier_cells`, numbered as ``scipy.ndimage.label``
-numbers them) from a frontier mask the caller keeps up to date where the belief changed
-(:func:`~frontier_marl.core.frontiers.update_frontier`), and finds the slot nearest by path with
-a breadth-first search that stops as soon as the answer is sure; when it cannot be, it builds
+union-find over the frontier cells alone (numbered as ``scipy.ndimage.label`` numbers them),
+from a frontier mask the caller keeps up to date where the belief changed (both in
+:mod:`frontier_marl.core.frontier_union`). It finds the slot nearest by path with a
+breadth-first search that stops as soon as the answer is sure; when it cannot be, it builds
 the slots as the env does (:func:`~frontier_marl.core.slots._robot_slots`) and takes
 :func:`nearest_path` of them.
 """
@@ -17,12 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.frontiers import (
-    cluster_stats,
-    label_frontier_cells,
-    split_and_renumber,
-    update_frontier,
-)
+from frontier_marl.core.frontier_union import label_frontier_cells, update_frontier
+from frontier_marl.core.frontiers import cluster_stats, split_and_renumber
 from frontier_marl.core.grid import FREE
 from frontier_marl.core.slots import _robot_slots, nearest_targets
 
@@ -32,7 +27,7 @@ class DecisionScratch:
     of rollouts: four int64 buffers of a cell each, an (H, W) grid and a flat buffer that
     hold -1 between calls, and the frontier mask of the world being decided with its
     per-row counts (:func:`start_frontier`, then
-    :func:`~frontier_marl.core.frontiers.update_frontier` where its belief changed)."""
+    :func:`~frontier_marl.core.frontier_union.update_frontier` where its belief changed)."""
 
     def __init__(self, shape: tuple[int, int]) -> None:
         cells = shape[0] * shape[1]
@@ -93,7 +88,7 @@ def nearest_path_goal(
 ) -> np.ndarray:
     """:class:`NearestPathBase`'s target for the robot at (row, col) on ``belief``: its
     frontier clusters as :meth:`Worlds.refresh_clusters` makes them (labelled by
-    :func:`~frontier_marl.core.frontiers.label_frontier_cells`, split above
+    :func:`~frontier_marl.core.frontier_union.label_frontier_cells`, split above
     ``max_cluster_cells``), its slots, the nearest by path; (-1, -1) if none is live.
     ``scratch``: :meth:`DecisionScratch.arrays`, its frontier mask that of ``belief``."""
     rows, cols, label, parent, index, distance, frontier, row_count = scratch

@@ -25,7 +25,8 @@ from typing import Protocol
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.frontiers import is_frontier, update_frontier
+from frontier_marl.core.frontier_union import update_frontier
+from frontier_marl.core.frontiers import is_frontier
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slots import SlotArrays
