@@ -177,6 +177,32 @@ def test_the_compiled_nearest_path_rollouts_walk_as_the_generic_route(kwargs, se
     assert (runs[0][0] < 4 * world.belief.size).all()  # every rollout reached the coverage
 
 
+@pytest.mark.parametrize("route", [NearestPathBase, _SlotRoute])
+@pytest.mark.parametrize("seed", [3, 11, 19])
+def test_pruned_rollouts_keep_the_cheapest_costs_and_only_raise_the_others(route, seed) -> None:
+    env = FrontierParallelEnv(preset="rooms-32")
+    env.reset(seed=seed)
+    while env.mdp.slot_arrays().live[0] < 4:  # a decision with a few candidates
+        (mask,) = env.mdp.action_masks()
+        env.mdp.step([_valid(mask, 0)])
+    world = env.world
+    slots = env.mdp.slot_arrays()
+    targets = slots.target[0, : int(slots.live[0])]
+    start, cap = int(world.travelled[0]), 4 * world.belief.size
+    runs = []
+    for prune in (False, True):
+        sims = branch(world.batch, world.index, len(targets))
+        sims.goals[:, 0] = targets
+        runs.append(rollout_costs(sims, start, 0.99, cap, route(), prune))  # type: ignore[arg-type]
+    exact, pruned = runs
+    cheapest = exact == exact.min()
+    assert np.array_equal(pruned[cheapest], exact[cheapest])
+    assert ((pruned[~cheapest] == exact[~cheapest]) | (pruned[~cheapest] == cap)).all()
+    if route is NearestPathBase:  # world after world: each is pruned by those before it
+        before = np.minimum.accumulate(np.concatenate([[cap], exact[:-1]]))
+        assert np.array_equal(pruned, np.where(exact <= before, exact, cap))
+
+
 def test_clones_do_not_touch_their_source() -> None:
     env = _env(5, [0, 1])
     world = env.world
@@ -210,13 +236,17 @@ def test_rollouts_end_at_coverage_at_the_cap_or_when_stuck() -> None:
 
 def test_oracle_gives_the_per_clone_routes_costs_and_t99() -> None:
     """Recorded with the per-clone route (lookahead_costs stepping one Worlds batch in
-    lockstep, main at 1fa19b7): random-20, validation episodes 0 and 1."""
+    lockstep, main at 1fa19b7): random-20, validation episodes 0 and 1. The oracle prunes
+    its rollouts and orders its candidates by path; the unpruned costs are the recorded ones
+    (sorted: the recording was in slot order), and pruning keeps their argmin."""
     costs: list[list[int]] = []
     original = lookahead.lookahead_costs
 
     def recording(*args: object, **kwargs: object) -> np.ndarray:
         out = original(*args, **kwargs)  # type: ignore[arg-type]
-        costs.append(out.tolist())
+        exact = original(*args, **{**kwargs, "prune": False})  # type: ignore[arg-type]
+        assert out.argmin() == exact.argmin() and out.min() == exact.min()
+        costs.append(sorted(exact.tolist()))
         return out
 
     fam = family("random-20")
@@ -226,7 +256,7 @@ def test_oracle_gives_the_per_clone_routes_costs_and_t99() -> None:
     finally:
         lookahead.lookahead_costs = original  # type: ignore[assignment]
     assert [e.cells_to_coverage["0.99"] for e in result.episodes] == [88.0, 112.0]
-    assert costs[:3] == [[93, 107], [92, 104], [91, 89]]
+    assert costs[:3] == [[93, 107], [92, 104], [89, 91]]
 
 
 def test_the_documented_example_runs() -> None:

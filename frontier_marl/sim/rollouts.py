@@ -73,20 +73,29 @@ class NearestPathBase:
 
 
 def rollout_costs(
-    sims: Worlds, start: int, coverage: float, max_cells: int, base: RolloutBase
+    sims: Worlds,
+    start: int,
+    coverage: float,
+    max_cells: int,
+    base: RolloutBase,
+    prune: bool = False,
 ) -> np.ndarray:
     """Cells robot 0 of each world of ``sims`` walks beyond ``start`` until ``coverage`` of its
     reachable free region is known, heading first for its current goal (``sims.goals``) and
     then where ``base`` sends it; a world that walks ``max_cells`` or has nothing reachable
-    left to explore before that costs ``max_cells``."""
+    left to explore before that costs ``max_cells``.
+
+    ``prune``: only the cheapest worlds matter (branch and bound). A world is stopped as soon
+    as it has walked more than the cheapest one finished so far, and then costs ``max_cells``:
+    every world of the least cost keeps its exact cost, the others only read as dearer."""
     n = sims.n_worlds
     state = _RolloutState(sims, max_cells)
     if isinstance(base, NearestPathBase):  # the whole rollout in one compiled call
-        _rollout_nearest_path(sims, state, start, coverage, max_cells, base.n_slots)
+        _rollout_nearest_path(sims, state, start, coverage, max_cells, base.n_slots, prune)
         return state.cost
     slots = SlotArrays.empty(n, 1, base.n_slots)
     while True:
-        _advance(sims, state, start, coverage, max_cells)
+        _advance(sims, state, start, coverage, _cap(state, max_cells) if prune else max_cells)
         deciding = np.flatnonzero(state.deciding)
         if len(deciding) == 0:
             return state.cost
@@ -137,15 +146,27 @@ def _advance(sims: Worlds, state: _RolloutState, start: int, coverage: float, ca
     advance(state.arrays(), _world_arrays(sims), start, coverage, cap, state.deciding)
 
 
+def _cap(state: _RolloutState, max_cells: int) -> int:
+    """The walk at which a world can no longer be among the cheapest: one cell more than the
+    cheapest finished world (``max_cells`` while none has)."""
+    return min(max_cells, int(state.cost.min(initial=max_cells)) + 1)
+
+
 def _rollout_nearest_path(
-    sims: Worlds, state: _RolloutState, start: int, coverage: float, cap: int, n_slots: int
+    sims: Worlds,
+    state: _RolloutState,
+    start: int,
+    coverage: float,
+    cap: int,
+    n_slots: int,
+    prune: bool,
 ) -> None:
     params = sims.params
     scratch = DecisionScratch(sims.shape)
     reach = int(np.abs(params.sensor.rays[0]).max(initial=0))  # a sensed cell's farthest change
     rollout_nearest_path(
         state.arrays(), _world_arrays(sims), start, coverage, cap, params.connectivity,
-        params.max_cluster_cells, n_slots, reach, scratch.arrays(),
+        params.max_cluster_cells, n_slots, reach, scratch.arrays(), prune,
     )  # fmt: skip
 
 
@@ -218,21 +239,24 @@ def rollout_nearest_path(
     n_slots: int,
     reach: int,
     scratch: tuple,
+    prune: bool,
 ) -> None:
     """Every world rolled out to its end with :class:`NearestPathBase` deciding, world after
     world (the worlds are independent); ``scratch``: :meth:`DecisionScratch.arrays`. The
     frontier mask is made once per world, then brought up to date before each decision
     within ``reach`` + 1 cells of where the robots sensed (``reach``: the sensor's farthest
-    offset)."""
-    done, pending, sensed = state[0], state[1], state[5]
+    offset). ``prune``: each world stops once it has walked more than the cheapest one before
+    it (:func:`rollout_costs`)."""
+    done, pending, cost, sensed = state[0], state[1], state[2], state[5]
     belief, positions, goals = world[3], world[5], world[7]
     frontier, row_count = scratch[6], scratch[7]
     margin = reach + 1
+    cap = max_cells
     for n in range(len(done)):
         start_frontier(belief[n], scratch)
         sensed[n, 0], sensed[n, 1] = 1, 0
         while not done[n]:
-            if not advance_world(n, state, world, start, coverage, max_cells):
+            if not advance_world(n, state, world, start, coverage, cap):
                 continue
             box = sensed[n]
             if box[0] <= box[1]:
@@ -251,6 +275,8 @@ def rollout_nearest_path(
                 goals[n, 0, 0] = goal[0]
                 goals[n, 0, 1] = goal[1]
                 pending[n] = True
+        if prune:
+            cap = min(cap, cost[n] + 1)
 
 
 @compiled
