@@ -17,7 +17,7 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.sim.decisions import decide, heading_of
+from frontier_marl.sim.decisions import count_progress, decide, settle
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
@@ -62,6 +62,11 @@ class BatchMDP:
             np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
         )
         self._all = np.arange(n)
+        # the step's own buffers: the chosen targets, padding and oscillation flags, and the
+        # cells walked before it
+        chosen_flags = (np.empty((n, k), dtype=bool), np.empty((n, k), dtype=bool))
+        self._chosen = (np.empty((n, k, 2), dtype=np.int64), *chosen_flags)
+        self._before = np.empty((n, k), dtype=np.int64)
 
     # ------------------------------------------------------------------ episodes
     def reset_worlds(self, worlds: np.ndarray) -> None:
@@ -88,24 +93,19 @@ class BatchMDP:
         holds valid slot indices (checked by the caller). Inactive worlds (ended, or waiting
         while others play forced steps) keep their state: they do not move and get no reward
         or end flag."""
-        slots = self.slots
-        history = self._oscillation.history
-        chosen = np.asarray(actions, dtype=np.int64)
-        targets = np.empty((self.n_worlds, self.n_agents, 2), dtype=np.int64)
-        padding = np.empty((self.n_worlds, self.n_agents), dtype=bool)
-        oscillation = np.empty_like(padding)
-        decide(slots.live, slots.target, chosen, active, history, targets, padding, oscillation)
-        worlds = self.worlds
-        before = worlds.travelled.copy()
+        slots, worlds = self.slots, self.worlds
+        targets, padding, oscillation = self._chosen
+        decide(
+            slots.live, slots.target, np.asarray(actions, dtype=np.int64), active,
+            self._oscillation.history, targets, padding, oscillation,
+        )  # fmt: skip
+        np.copyto(self._before, worlds.travelled)
         if self._trail is not None:
             self._trail.push(worlds.positions, active)
         worlds.move(targets, active)
-        new_cells = np.where(active[:, None], worlds.new_cells, 0)
-        self.steps += active
-        progress = new_cells.any(axis=1)
-        self.steps_without_progress = np.where(progress, 0, self.steps_without_progress + active)
-        indices = self._all[active]
-        worlds.slots(slots, indices, self.cfg.observation.sort_by_distance, self.packed)
+        new_cells = np.empty_like(self.new_cells)  # fresh: the last step's stay readable
+        count_progress(active, worlds.new_cells, new_cells, self.steps, self.steps_without_progress)
+        worlds.slots(slots, self._all[active], self.cfg.observation.sort_by_distance, self.packed)
         if self.cfg.observation.commit != "none":
             slots.mask[:] = commit_to_previous(
                 slots.mask,
@@ -123,25 +123,16 @@ class BatchMDP:
             padding,
             oscillation,
             fraction >= reward.explore_threshold,
-            (slots.live == 0).all(axis=1),
+            ~slots.live.any(axis=1),
             self.steps,
             self.steps_without_progress,
-            worlds.travelled - before,
+            worlds.travelled - self._before,
         )
-        # inactive worlds keep their state: no reward, no new end
-        outcome.rewards[~active] = 0.0
-        outcome.terminated &= active
-        outcome.truncated &= active
-        outcome.reason[~active] = 0
-        self.done |= outcome.terminated | outcome.truncated
-        # inactive worlds keep their targets, heading and flags
-        moved = active[:, None]
-        heading = np.empty_like(targets)
-        heading_of(targets, worlds.reached, heading)
-        self.heading = np.where(moved[..., None], heading, self.heading)
-        self.targets = np.where(moved[..., None], targets, self.targets)
-        self.padding = np.where(moved, padding, self.padding)
-        self.oscillation = np.where(moved, oscillation, self.oscillation)
+        settle(
+            active, targets, worlds.reached, padding, oscillation, outcome.rewards,
+            outcome.terminated, outcome.truncated, outcome.reason, self.done, self.targets,
+            self.heading, self.padding, self.oscillation,
+        )  # fmt: skip
         self.new_cells, self.outcome = new_cells, outcome
 
     def play_forced(self) -> None:

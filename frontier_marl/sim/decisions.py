@@ -53,3 +53,60 @@ def heading_of(targets: np.ndarray, reached: np.ndarray, heading: np.ndarray) ->
             going = targets[w, n, 0] >= 0 and not reached[w, n]
             heading[w, n, 0] = targets[w, n, 0] if going else -1
             heading[w, n, 1] = targets[w, n, 1] if going else -1
+
+
+@compiled
+def count_progress(
+    active: np.ndarray,
+    walked_cells: np.ndarray,
+    new_cells: np.ndarray,
+    steps: np.ndarray,
+    without_progress: np.ndarray,
+) -> None:
+    """After a walk of the ``active`` worlds (W,): ``new_cells`` (W, N) the cells each robot
+    revealed (``walked_cells``; 0 in inactive worlds), and the active worlds' step counters
+    ``steps`` and ``without_progress`` (W,) advanced (the latter back to 0 when any cell was
+    revealed)."""
+    for w in range(len(active)):
+        progress = False
+        for n in range(new_cells.shape[1]):
+            new_cells[w, n] = walked_cells[w, n] if active[w] else 0
+            progress = progress or new_cells[w, n] > 0
+        if active[w]:
+            steps[w] += 1
+            without_progress[w] = 0 if progress else without_progress[w] + 1
+
+
+@compiled
+def settle(
+    active: np.ndarray,
+    targets: np.ndarray,
+    reached: np.ndarray,
+    padding: np.ndarray,
+    oscillation: np.ndarray,
+    rewards: np.ndarray,
+    terminated: np.ndarray,
+    truncated: np.ndarray,
+    reason: np.ndarray,
+    done: np.ndarray,
+    kept_targets: np.ndarray,
+    kept_heading: np.ndarray,
+    kept_padding: np.ndarray,
+    kept_oscillation: np.ndarray,
+) -> None:
+    """The end of a step of the ``active`` worlds (W,): inactive worlds get no reward, end
+    or reason, and keep their ``kept_*`` arrays (targets and heading (W, N, 2), flags (W, N));
+    active ones store the step's ``targets``, ``padding`` and ``oscillation``, their heading
+    (:func:`heading_of` with ``reached``), and are ``done`` once terminated or truncated."""
+    for w in range(len(active)):
+        if not active[w]:
+            rewards[w] = 0.0
+            terminated[w] = False
+            truncated[w] = False
+            reason[w] = 0
+            continue
+        done[w] = done[w] or terminated[w] or truncated[w]
+        heading_of(targets[w : w + 1], reached[w : w + 1], kept_heading[w : w + 1])
+        kept_targets[w] = targets[w]
+        kept_padding[w] = padding[w]
+        kept_oscillation[w] = oscillation[w]
