@@ -188,6 +188,16 @@ def test_samples_survive_a_round_trip_and_a_join(labelled: Samples, tmp_path: Pa
     assert joined.decision.max() + 1 == 2 * (labelled.decision.max() + 1)
 
 
+def test_a_fit_depends_on_its_seed_alone(labelled: Samples) -> None:
+    reg = cost_regression.RegressionSettings(fit_epochs=1, scorer_width=8)
+    first = cost_regression.fitted(labelled, reg, seed=3).state_dict()
+    torch.rand(7)  # the global generator moves on: the fit must not read it
+    again = cost_regression.fitted(labelled, reg, seed=3).state_dict()
+    other = cost_regression.fitted(labelled, reg, seed=4).state_dict()
+    assert all(torch.equal(first[key], again[key]) for key in first)
+    assert not all(torch.equal(first[key], other[key]) for key in first)
+
+
 @pytest.mark.slow
 def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path) -> None:
     out = tmp_path / "run"

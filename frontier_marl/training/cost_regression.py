@@ -175,9 +175,12 @@ def fitted(
     scale: np.ndarray | None = None,
 ) -> Any:
     """A new scorer fitted to ``samples`` (with ``loss``, :data:`~frontier_marl.training.
-    regression.LOSSES`, on the target of :func:`~frontier_marl.training.regression.group`)."""
+    regression.LOSSES`, on the target of :func:`~frontier_marl.training.regression.group`),
+    initialised and shuffled from ``seed`` alone: the same arguments give the same scorer."""
     decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]), scale)
-    model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
+    with torch.random.fork_rng(devices=[]):  # the caller's torch generator is left as it was
+        torch.manual_seed(seed)
+        model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))
