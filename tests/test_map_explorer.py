@@ -19,6 +19,12 @@ from frontier_marl.evaluation.benchmark.contenders import map_model  # noqa: E40
 from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (  # noqa: E402
     main as ablation_main,
 )
+from frontier_marl.experiments.explorer_studies.map_scorer_ensemble import (  # noqa: E402
+    Averaged,
+)
+from frontier_marl.experiments.explorer_studies.map_scorer_ensemble import (  # noqa: E402
+    main as ensemble_main,
+)
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS  # noqa: E402
@@ -245,6 +251,23 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
         (held_out,) = variant["held_out_decisions"].values()  # round 1's random-20 decisions
         assert held_out["decisions"] > 0 and "frontier-rule" in held_out["choosers"]
         assert set(variant["validation"]["0.0"]["by_family"]) == {"random-20"}
+    ensemble_json = tmp_path / "ensemble.json"
+    ensemble_args = ["--sizes", "1,2", "--weights", "0,1", "--episodes", "1", "--epochs", "1"]
+    assert ensemble_main([str(out), *ensemble_args, "--json", str(ensemble_json)]) == 0
+    ensemble = json.loads(ensemble_json.read_text())
+    assert ensemble["labels"] == records[1]["labels"] and list(ensemble["sizes"]) == ["1", "2"]
+    assert set(ensemble["sizes"]["2"]["1.0"]["by_family"]) == {"random-20"}
+
+
+def test_an_average_of_one_scorer_is_that_scorer_and_of_two_their_mean() -> None:
+    torch.manual_seed(0)
+    first, second = new_scorer(14, 8).eval(), new_scorer(14, 8).eval()
+    crops, features = torch.rand(2, 3, *map_crops.crop_shape()), torch.rand(2, 3, 14)
+    mask = torch.tensor([[True, True, False], [True, True, True]])
+    with torch.no_grad():
+        one, two = first(crops, features, mask), second(crops, features, mask)
+        assert torch.equal(Averaged([first])(crops, features, mask), one)
+        assert torch.allclose(Averaged([first, second])(crops, features, mask), (one + two) / 2)
 
 
 def test_the_fit_losses_have_their_known_values() -> None:

@@ -83,11 +83,12 @@ def map_sides(families: np.ndarray) -> np.ndarray:
     return np.array([side[name] for name in families.tolist()])
 
 
-def run_labels(run: Path) -> list[Samples]:
-    """Every round's labels of a cost-regression run, in round order."""
+def run_labels(run: Path, minimum: int = 2) -> list[Samples]:
+    """Every round's labels of a cost-regression run, in round order (ValueError when there
+    are fewer than ``minimum`` rounds)."""
     paths = sorted((run / "labels").glob("round*.npz"), key=lambda p: int(p.stem[5:]))
-    if len(paths) < 2:
-        raise ValueError(f"{run}/labels holds {len(paths)} rounds; the ablation needs two or more")
+    if len(paths) < minimum:
+        raise ValueError(f"{run}/labels holds {len(paths)} rounds; this needs {minimum} or more")
     return [Samples.load(path) for path in paths]
 
 

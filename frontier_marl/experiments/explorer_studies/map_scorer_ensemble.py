@@ -1,0 +1,93 @@
+"""How much of the map scorer's error is model variance: scorers fitted alike but for their
+seeds, and their average (docs/experiments/2026-12-04-map-aware-explorer.md). Validation seeds
+only.
+
+It fits ``max(--sizes)`` scorers on every round's labels of a cost-regression run (``frontier-
+marl train explorer-map``), with the run's fit settings and the seeds ``seed``, ``seed + 1``,
+..., and scores, for each k of ``--sizes``, the mean predicted regret of the first k
+(:class:`Averaged`) against frontier-rule on ``--episodes`` validation episodes of every family
+at each rule weight of ``--weights`` (k = 1 is one plain fit)::
+
+    python benchmarks/explorer_map_ensemble.py runs/explorer-map-r0 --sizes 1,4,8 \\
+        --weights 0,0.5,1 --episodes 16 --json ensemble.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import torch
+from torch import nn
+
+from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (
+    run_experiment,
+    run_labels,
+)
+from frontier_marl.training.cost_regression import Validation, fitted
+from frontier_marl.training.cost_to_go import Samples
+from frontier_marl.training.settings import RegressionSettings
+from frontier_marl.utils.progress import progress_bar
+
+
+class Averaged(nn.Module):
+    """Scorers of one shape as one: the mean of their predicted regrets."""
+
+    def __init__(self, members: list[nn.Module]) -> None:
+        super().__init__()
+        self.members = nn.ModuleList(members)
+        self.feature_mean = members[0].feature_mean  # what MapExplorer checks its env against
+
+    def forward(
+        self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor
+    ) -> torch.Tensor:
+        return torch.stack([member(crops, features, mask) for member in self.members]).mean(0)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run", type=Path, help="a cost-regression run folder")
+    parser.add_argument("--sizes", default="1,4,8", help="ensemble sizes, comma-separated")
+    parser.add_argument("--weights", default="0,0.5,1", help="rule weights, comma-separated")
+    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
+    parser.add_argument("--epochs", type=int, default=None, help="default: the run's")
+    parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--json", type=Path, default=None)
+    args = parser.parse_args(argv)
+    try:
+        sizes = [int(k) for k in args.sizes.split(",")]
+        weights = [float(w) for w in args.weights.split(",")]
+        train = Samples.join(run_labels(args.run, minimum=1))
+        experiment = run_experiment(args.run)
+    except (ValueError, OSError, KeyError) as exc:
+        parser.error(str(exc))
+    if min(sizes) < 1:
+        parser.error(f"--sizes must be integers >= 1, got {args.sizes}")
+    settings = dict(experiment.regression)
+    if args.epochs is not None:
+        settings["fit_epochs"] = args.epochs
+    reg = RegressionSettings(**settings)
+    seed = experiment.train.seed
+    members = []
+    with progress_bar(max(sizes), disable=args.no_progress, desc="fits", unit="fit") as bar:
+        for offset in range(max(sizes)):
+            members.append(fitted(train, reg, seed + offset))
+            bar.update(1)
+    validation = Validation(list(experiment.train.families), args.episodes)
+    report: dict[str, Any] = {"run": str(args.run), "labels": len(train), "sizes": {}}
+    for k in sizes:
+        model = Averaged(members[:k]).eval()
+        results = {str(w): validation(model, w) for w in weights}
+        report["sizes"][str(k)] = results
+        for weight, result in results.items():
+            families = ", ".join(f"{n} {v:+.1%}" for n, v in result["by_family"].items())
+            print(
+                f"{k} scorer(s), rule weight {weight}: T99 vs frontier-rule "
+                f"{result['vs_frontier_rule']:+.1%} ({families})",
+                flush=True,
+            )
+    if args.json is not None:
+        args.json.write_text(json.dumps(report, indent=2) + "\n")
+    return 0
