@@ -105,7 +105,6 @@ def fit_variant(name: str, train: Samples, reg: RegressionSettings, seed: int) -
         train = Samples(
             np.zeros_like(train.crops), train.features, train.cost, train.decision, train.family
         )
-    torch.manual_seed(seed)
     model = fitted(train, reg, seed, loss, map_sides(train.family) if in_cells else None)
     return model if reads_map else BlankMap(model).eval()
 

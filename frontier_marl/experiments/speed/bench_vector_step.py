@@ -5,9 +5,9 @@ test: run it by hand.
 
 The env of the DQN share row: :func:`frontier_marl.vector_env` with configuration 1's settings,
 ``info="mask"``, the flat layout and same-step autoreset (what the SB3 adapter steps), random
-valid slots. Each part is timed by a wall-clock timer wrapped around its call (a timer costs
-well under a microsecond); the parts nest as printed, and "the rest" of a part is its time
-outside the parts listed under it.
+valid slots. Each part is timed by a wall-clock timer wrapped around its call (each wrapper
+adds a Python call, so the whole runs a little slower than unwrapped); the parts nest as
+printed, and "the rest" of a part is its time outside the parts listed under it.
 """
 
 from __future__ import annotations
