@@ -62,6 +62,7 @@ class BatchMDP:
             np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
         )
         self._all = np.arange(n)
+        self._every_row = self.slots.rows(slice(None))  # (N*K, ...) views, made once
         # the step's own buffers: the chosen targets, padding and oscillation flags, and the
         # cells walked before it
         chosen_flags = (np.empty((n, k), dtype=bool), np.empty((n, k), dtype=bool))
@@ -163,8 +164,9 @@ class BatchMDP:
         count = shape[0] * shape[1]
         mates = self._teammates(worlds)
         motion = None if self._trail is None else self._trail.motion(worlds, positions)
+        every = isinstance(worlds, slice) and worlds == slice(None)
         batch = self.encoder.encode_batch(
-            self.slots.rows(worlds),
+            self._every_row if every else self.slots.rows(worlds),
             positions.reshape(count, 2),
             None if mates is None else mates.reshape(count, -1),
             self.heading[worlds].reshape(count, 2),
