@@ -16,7 +16,9 @@ import argparse
 import json
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from typing import Any
+from unittest.mock import patch
 
 import numpy as np
 
@@ -56,27 +58,19 @@ def breakdown(worlds: int, steps: int, seed: int = 0) -> dict[str, Any]:
         "engine": batch_engine, "kernels": worlds_module,
     }  # fmt: skip
     spent: dict[str, float] = dict.fromkeys([part for part, _, _ in PARTS], 0.0)
-    restore = []
-    for part, _, where in PARTS:
-        owner_name, attribute = where.split(".")
-        owner = owners[owner_name]
-        original = getattr(owner, attribute)
-        setattr(owner, attribute, _timed(original, part, spent))
-        restore.append((owner, attribute, original, owner_name in ("engine", "kernels")))
-    try:
+    with ExitStack() as wrappers:  # each part timed until the end of the block
+        for part, _, where in PARTS:
+            owner_name, attribute = where.split(".")
+            owner = owners[owner_name]
+            timed = _timed(getattr(owner, attribute), part, spent)
+            wrappers.enter_context(patch.object(owner, attribute, timed))
         rng = np.random.default_rng(seed)
         _, infos = env.reset(seed=seed)
-        for timed in (False, True):
+        for measured in (False, True):
             for key in spent:
                 spent[key] = 0.0
-            for _ in range(steps if timed else 200):
+            for _ in range(steps if measured else 200):
                 _, _, _, _, infos = env.step(random_valid(infos["action_mask"], rng))
-    finally:
-        for owner, attribute, original, module in reversed(restore):
-            if module:
-                setattr(owner, attribute, original)
-            else:
-                delattr(owner, attribute)  # the instance's wrapper; the class method is back
     per_step = {part: seconds / steps * 1e6 for part, seconds in spent.items()}
     rest = dict(per_step)
     for part, parent, _ in PARTS:
