@@ -3,9 +3,10 @@
 Every operation of a decision step runs for all worlds in one compiled call (the walk of every
 robot, frontier masks, cluster splitting and statistics, the slots of every robot), and the
 frontier masks of all worlds whose belief changed are labelled by **one**
-``scipy.ndimage.label`` call: the masks are stacked along a first axis that the structuring
-element does not connect, so no component crosses from one world to the next, and labels are
-numbered world by world in raster order, exactly as one call per world would number them.
+``scipy.ndimage.label`` call: the masks, each ending in a blank row, are labelled as one image
+(:func:`~frontier_marl.core.frontiers.label_tiled`), so no component crosses from one world to
+the next, and labels are numbered world by world in raster order, exactly as one call per world
+would number them.
 :class:`~frontier_marl.core.world.World` is the same thing for one world.
 
 Arrays are indexed ``[world, ...]`` and ``[world, robot, ...]``; read them, never write them.
@@ -22,7 +23,7 @@ from frontier_marl.core.frontiers import (
     Clusters,
     cluster_worlds,
     fill_frontier_masks,
-    stacked_structure,
+    label_tiled,
     unknown_around,
 )
 from frontier_marl.core.grid import FREE, UNKNOWN
@@ -88,9 +89,9 @@ class Worlds:
         self.gains = np.zeros((n, cells))
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
-        self._masks = np.zeros((n, height, width), dtype=bool)  # a recluster's buffers
-        self._labels = np.zeros((n, height, width), dtype=np.int32)
-        self._structure = stacked_structure(params.connectivity)
+        # a recluster's buffers, one blank row below each world (see label_tiled)
+        self._masks = np.zeros((n, height + 1, width), dtype=bool)
+        self._labels = np.zeros((n, height + 1, width), dtype=np.int32)
         self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
 
     # ----------------------------------------------------------------- episodes
@@ -173,7 +174,7 @@ class Worlds:
         stale = np.flatnonzero(self.clustered_version != self.version)
         masks, labels = self._masks[: len(stale)], self._labels[: len(stale)]
         fill_frontier_masks(self.belief, stale, masks)
-        ndimage.label(masks, structure=self._structure, output=labels)
+        label_tiled(masks, self.params.connectivity, labels)
         cluster_worlds(
             labels,
             stale,
