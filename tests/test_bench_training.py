@@ -18,10 +18,10 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
     stages = report["stages"]
     assert set(stages) == {
         "move",
-        "_refresh_slots",
+        "slots",
         "ndimage.label",
-        "_observations",
-        "batch_outcome",
+        "observations",
+        "finish_step",
         "build_infos",
         "reset",
     }
@@ -34,12 +34,12 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
 
 
 def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
-    from frontier_marl.core import world
-    from frontier_marl.sim import engine
+    from frontier_marl.core import worlds
+    from frontier_marl.sim import batch_engine, engine
 
-    before = (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset)
+    before = (worlds.Worlds.move, batch_engine.finish_step, engine.ExplorationMDP.reset)
     bench_training.main(["config01", "--steps", "200", "--stages"])
-    assert (world.World.move, engine.batch_outcome, engine.ExplorationMDP.reset) == before
+    assert (worlds.Worlds.move, batch_engine.finish_step, engine.ExplorationMDP.reset) == before
 
 
 def test_labelling_benchmark_counts(tmp_path: Path) -> None:

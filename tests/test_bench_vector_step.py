@@ -12,7 +12,7 @@ from frontier_marl.sim import batch_engine
 
 
 def test_the_breakdown_reports_every_part_and_restores_the_env(tmp_path: Path) -> None:
-    kernels = (batch_engine.decide, batch_engine.settle, worlds_module.all_slots)
+    kernels = (batch_engine.decide, batch_engine.finish_step, worlds_module.all_slots)
     out = tmp_path / "step.json"
     assert bench_vector_step.main(["--worlds", "2", "--steps", "20", "--json", str(out)]) == 0
     report = json.loads(out.read_text())
@@ -21,4 +21,4 @@ def test_the_breakdown_reports_every_part_and_restores_the_env(tmp_path: Path) -
     assert all(value > 0 for part, value in per_step.items() if part != "autoresets")
     slots = "all_slots (distance fields, slot tables)"
     assert per_step["step"] > per_step["mdp.step"] > per_step["slots"] > per_step[slots]
-    assert (batch_engine.decide, batch_engine.settle, worlds_module.all_slots) == kernels
+    assert (batch_engine.decide, batch_engine.finish_step, worlds_module.all_slots) == kernels

@@ -19,7 +19,7 @@ from frontier_marl.evaluation.benchmark.families import family, variant_configs
 from frontier_marl.evaluation.benchmark.run import oracle, run_family
 from frontier_marl.policies import lookahead
 from frontier_marl.sim.batch_engine import BatchMDP
-from frontier_marl.sim.branching import branch, branch_mdp
+from frontier_marl.sim.branching import branch, branch_mdp, clone_mdp
 from frontier_marl.sim.engine import ExplorationMDP
 from frontier_marl.sim.nearest_path import DecisionScratch, nearest_path_goal, start_frontier
 from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
@@ -94,6 +94,43 @@ def test_a_clone_steps_exactly_as_its_original(kwargs: dict[str, object]) -> Non
             assert np.array_equal(outcome.rewards, batch.outcome.rewards[row])
             assert outcome.terminated == batch.outcome.terminated[row]
             assert outcome.truncated == batch.outcome.truncated[row]
+
+
+def test_a_clone_of_any_world_of_a_batch_steps_as_that_world() -> None:
+    """clone_mdp copies world 1 of three mid-episode; each copy then plays world 1's steps."""
+    from frontier_marl.config import make_config
+
+    cfg = make_config("thesis-20x20", n_agents=2, features="explorer", teammates="positions")
+    source = BatchMDP(cfg, 3)
+    source.rngs = [np.random.default_rng(seed) for seed in (5, 6, 7)]
+    source.reset_worlds(np.arange(3))
+    rng = np.random.default_rng(0)
+
+    def play(batch: BatchMDP, active: np.ndarray) -> np.ndarray:
+        masks = batch.slots.mask
+        actions = (rng.random(masks.shape) * masks).argmax(axis=2)
+        batch.step(actions, active)
+        return actions
+
+    for _ in range(3):
+        play(source, ~source.done)
+    assert not source.done[1]
+    clones = clone_mdp(source, 1, 2)
+    only_one = np.array([False, True, False])
+    for _ in range(4):
+        if source.done[1]:
+            break
+        actions = play(source, only_one)
+        clones.step(np.repeat(actions[1:2], 2, axis=0), np.ones(2, dtype=bool))
+        mine, theirs = source.observations(np.array([1])), clones.observations()
+        for row in range(2):
+            assert np.array_equal(clones.worlds.belief[row], source.worlds.belief[1])
+            assert np.array_equal(clones.worlds.positions[row], source.worlds.positions[1])
+            assert np.array_equal(clones.slots.mask[row], source.slots.mask[1])
+            assert np.array_equal(clones.outcome.rewards[row], source.outcome.rewards[1])
+            assert clones.done[row] == source.done[1]
+            for key, value in mine.items():
+                assert np.array_equal(theirs[key][row], value[0]), key
 
 
 def test_branch_mdp_needs_an_episode_in_progress() -> None:

@@ -197,13 +197,8 @@ class FrontierVectorEnv(VectorEnv):
         return array.astype(np.int64, copy=False).reshape(self.n_worlds, self.n_agents)
 
     def _observations(self) -> Any:
-        batch = self.mdp.observations()
-        if isinstance(batch, dict):
-            n = self.num_envs
-            return self.layout.wrap(
-                {key: value.reshape(n, *value.shape[2:]) for key, value in batch.items()}
-            )
-        return batch.reshape(self.num_envs, *batch.shape[2:])
+        batch = self.mdp.robot_observations()  # (num_envs, ...): robots world after world
+        return self.layout.wrap(batch) if isinstance(batch, dict) else batch
 
     def _final(self, observations: Any, ended: np.ndarray) -> dict[str, Any]:
         """``final_obs`` and ``final_info`` of the worlds that just ended (same-step mode)."""

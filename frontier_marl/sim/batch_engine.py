@@ -12,26 +12,31 @@ it plays exactly the episodes of the single-world engine.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays, commit_to_previous
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.sim.decisions import count_progress, decide, settle
+from frontier_marl.sim.decisions import count_progress, decide, finish_step
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
-from frontier_marl.sim.rewards import BatchOutcome, OscillationHistory, batch_outcome
+from frontier_marl.sim.rewards import BatchOutcome, OscillationHistory, table_constants
 
 Observations = np.ndarray | dict[str, np.ndarray]
+_EVERY = slice(None)
 
 
 class BatchMDP:
     """Frontier-selection MDP of ``n_worlds`` worlds with ``cfg.n_agents`` robots each.
 
     After :meth:`step` the step's results are in arrays indexed ``[world, robot]``:
-    ``targets``, ``padding``, ``oscillation``, ``new_cells`` and ``outcome`` (rewards, flags,
-    end-reason codes). Worlds whose episode ended stay ``done`` until :meth:`reset_worlds`.
+    ``targets``, ``padding``, ``oscillation``, ``new_cells`` and ``outcome`` (fresh rewards;
+    flags and end-reason codes in arrays the next step overwrites), and ``explored`` (N,) holds
+    each world's explored fraction on the reward's threshold basis. Worlds whose episode ended
+    stay ``done`` until :meth:`reset_worlds`.
     """
 
     def __init__(self, cfg: EnvConfig, n_worlds: int) -> None:
@@ -53,21 +58,41 @@ class BatchMDP:
         self.steps = np.zeros(n, dtype=np.int64)
         self.steps_without_progress = np.zeros(n, dtype=np.int64)
         self.done = np.ones(n, dtype=bool)
+        self.explored = self.worlds.explored_fraction(cfg.reward.threshold_basis)  # (N,), read-only
         self.targets = np.full((n, k, 2), -1, dtype=np.int64)
         self.heading = np.full((n, k, 2), -1, dtype=np.int64)  # current targets, -1: none
         self.padding = np.zeros((n, k), dtype=bool)
         self.oscillation = np.zeros((n, k), dtype=bool)
         self.new_cells = np.zeros((n, k), dtype=np.int64)
-        self.outcome = BatchOutcome(
+        # the step's outcome: fresh rewards every step (they are handed out), the rest reused
+        self._ends = self.outcome = BatchOutcome(
             np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
         )
         self._all = np.arange(n)
-        self._every_row = self.slots.rows(slice(None))  # (N*K, ...) views, made once
+        self._make_views()
         # the step's own buffers: the chosen targets, padding and oscillation flags, and the
         # cells walked before it
         chosen_flags = (np.empty((n, k), dtype=bool), np.empty((n, k), dtype=bool))
         self._chosen = (np.empty((n, k, 2), dtype=np.int64), *chosen_flags)
         self._before = np.empty((n, k), dtype=np.int64)
+        self._travel = cfg.reward.kind == "travel"  # the only reward that reads the cells walked
+        self._events = (np.empty(n, dtype=bool), np.empty(n, dtype=bool))  # see world_events
+        self._kept = (self.targets, self.heading, self.padding, self.oscillation)  # see settle
+
+    def _make_views(self) -> None:
+        """Every robot's slots, position and heading as ``(N K, ...)`` views, made once (and
+        again after a copy: a copied view would no longer see its array)."""
+        self._every_row = self.slots.rows(_EVERY)
+        self._positions = self.worlds.positions.reshape(-1, 2)
+        self._heading = self.heading.reshape(-1, 2)
+
+    def __getstate__(self) -> dict[str, Any]:
+        views = ("_every_row", "_positions", "_heading")
+        return {k: v for k, v in self.__dict__.items() if k not in views}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._make_views()
 
     # ------------------------------------------------------------------ episodes
     def reset_worlds(self, worlds: np.ndarray) -> None:
@@ -87,6 +112,7 @@ class BatchMDP:
         self.oscillation[worlds] = False
         self.new_cells[worlds] = 0
         self.worlds.slots(self.slots, worlds, self.cfg.observation.sort_by_distance, self.packed)
+        self.explored = self.worlds.explored_fraction(self.cfg.reward.threshold_basis)
 
     # ------------------------------------------------------------------ transition
     def step(self, actions: np.ndarray, active: np.ndarray) -> None:
@@ -100,7 +126,8 @@ class BatchMDP:
             slots.live, slots.target, np.asarray(actions, dtype=np.int64), active,
             self._oscillation.history, targets, padding, oscillation,
         )  # fmt: skip
-        np.copyto(self._before, worlds.travelled)
+        if self._travel:
+            np.copyto(self._before, worlds.travelled)
         if self._trail is not None:
             self._trail.push(worlds.positions, active)
         worlds.move(targets, active)
@@ -117,24 +144,17 @@ class BatchMDP:
                 self.cfg.observation.commit,
             )
         reward = self.cfg.reward
-        fraction = worlds.explored_fraction(reward.threshold_basis)
-        outcome = batch_outcome(
-            reward,
-            new_cells,
-            padding,
-            oscillation,
-            fraction >= reward.explore_threshold,
-            ~slots.live.any(axis=1),
-            self.steps,
-            self.steps_without_progress,
-            worlds.travelled - self._before,
-        )
-        settle(
-            active, targets, worlds.reached, padding, oscillation, outcome.rewards,
-            outcome.terminated, outcome.truncated, outcome.reason, self.done, self.targets,
-            self.heading, self.padding, self.oscillation,
+        fraction = self.explored = worlds.explored_fraction(reward.threshold_basis)
+        ends = self._ends
+        ends.rewards = np.empty_like(ends.rewards)
+        finish_step(
+            *table_constants(reward), fraction, reward.explore_threshold, slots.live, new_cells,
+            self.steps, self.steps_without_progress,
+            worlds.travelled - self._before if self._travel else new_cells, self._events, active,
+            targets, worlds.reached, padding, oscillation,
+            (ends.rewards, ends.terminated, ends.truncated, ends.reason), self.done, self._kept,
         )  # fmt: skip
-        self.new_cells, self.outcome = new_cells, outcome
+        self.new_cells, self.outcome = new_cells, ends
 
     def play_forced(self) -> None:
         """Step every live world whose robots each have exactly one valid slot (a commitment,
@@ -157,25 +177,43 @@ class BatchMDP:
         self.outcome = BatchOutcome(rewards, terminated, truncated, reason)
 
     # ------------------------------------------------------------------ views
-    def observations(self, worlds: np.ndarray | slice = slice(None)) -> Observations:
-        """The robots' observations of ``worlds``, ``(len(worlds), K, ...)`` per key."""
-        positions = self.worlds.positions[worlds]
-        shape = positions.shape[:2]
-        count = shape[0] * shape[1]
-        mates = self._teammates(worlds)
-        motion = None if self._trail is None else self._trail.motion(worlds, positions)
-        every = isinstance(worlds, slice) and worlds == slice(None)
-        batch = self.encoder.encode_batch(
-            self._every_row if every else self.slots.rows(worlds),
-            positions.reshape(count, 2),
-            None if mates is None else mates.reshape(count, -1),
-            self.heading[worlds].reshape(count, 2),
-            None if motion is None else motion.reshape(count, 2),
-            self._beliefs(worlds),
-        )
+    def observations(self, worlds: np.ndarray | None = None) -> Observations:
+        """The robots' observations of ``worlds`` (indices; default: every world),
+        ``(len(worlds), K, ...)`` per key."""
+        batch = self.robot_observations(worlds)
+        shape = (-1, self.n_agents)
         if isinstance(batch, dict):
             return {key: value.reshape(*shape, *value.shape[1:]) for key, value in batch.items()}
         return batch.reshape(*shape, *batch.shape[1:])
+
+    def robot_observations(self, worlds: np.ndarray | None = None) -> Observations:
+        """The observations of the robots of ``worlds`` (indices; default: every world), world
+        after world, ``(len(worlds) K, ...)`` per key."""
+        if worlds is None:  # the common case: views made once, no indexing
+            chosen, rows, positions, heading = (
+                _EVERY,
+                self._every_row,
+                self._positions,
+                self._heading,
+            )
+        else:
+            chosen, rows = worlds, self.slots.rows(worlds)
+            positions = self.worlds.positions[worlds].reshape(-1, 2)
+            heading = self.heading[worlds].reshape(-1, 2)
+        mates = self._teammates(chosen)
+        motion = (
+            None
+            if self._trail is None
+            else self._trail.motion(chosen, self.worlds.positions[chosen])
+        )
+        return self.encoder.encode_batch(
+            rows,
+            positions,
+            None if mates is None else mates.reshape(len(positions), -1),
+            heading,
+            None if motion is None else motion.reshape(-1, 2),
+            self._beliefs(chosen),
+        )
 
     def _beliefs(self, worlds: np.ndarray | slice) -> np.ndarray | None:
         """The shared belief maps of ``worlds``, for the ``unknown_near`` feature."""

@@ -6,10 +6,10 @@
 * :func:`branch` makes a batch of K such clones; :func:`~frontier_marl.sim.rollouts.rollout_costs`
   then rolls them all out together, each with its own first target (the lookahead oracle,
   :mod:`frontier_marl.policies.lookahead`, and the cost-to-go labels are built on this).
-* :func:`branch_mdp` does the same one level up: the decision process of a single env (its
-  world, slots, step counters, oscillation history, motion trail and episode generator) becomes
-  K worlds of a :class:`~frontier_marl.sim.batch_engine.BatchMDP`, which steps each with its own
-  slot actions exactly as the original would.
+* :func:`clone_mdp` does the same one level up: one world of a decision process (its world,
+  slots, step counters, oscillation history, motion trail and episode generator) becomes K
+  worlds of a :class:`~frontier_marl.sim.batch_engine.BatchMDP`, which steps each with its own
+  slot actions exactly as the original would; :func:`branch_mdp` clones a single env's.
 """
 
 from __future__ import annotations
@@ -28,6 +28,10 @@ _STATE = (
     "true_free", "new_cells", "walked", "walked_len", "reached",
 )  # fmt: skip
 _PLANS = ("plan_cells", "plan_meta", "goals")
+_DECISIONS = (
+    "steps", "steps_without_progress", "done", "targets", "heading", "padding", "oscillation",
+    "new_cells",
+)  # fmt: skip
 
 
 def clone_world(
@@ -71,26 +75,27 @@ def branch_mdp(mdp: ExplorationMDP, count: int, rng: np.random.Generator | None 
     later episodes (an adapter's), copied into every world's (default: fresh ones)."""
     if mdp.world is None or mdp.done:
         raise RuntimeError("branch_mdp needs an episode in progress (after reset, not ended)")
-    batch = BatchMDP(mdp.cfg, count)
+    return clone_mdp(mdp.batch, 0, count, rng)
+
+
+def clone_mdp(
+    source: BatchMDP, index: int, count: int, rng: np.random.Generator | None = None
+) -> BatchMDP:
+    """A :class:`BatchMDP` of ``count`` copies of world ``index`` of ``source`` (its world,
+    slots, step counters, oscillation history, motion trail and last decisions), each of
+    which then steps exactly as the original would with the same actions. ``rng``: copied
+    into every world's episode generator (default: fresh ones)."""
+    batch = BatchMDP(source.cfg, count)
     rows = np.arange(count)
-    world = mdp.world
-    clone_world(world.batch, world.index, batch.worlds, rows)
+    clone_world(source.worlds, index, batch.worlds, rows)
     if rng is not None:
         batch.rngs = [copy.deepcopy(rng) for _ in rows]
-    slots = mdp.slot_arrays()
-    for name in slots.__slots__:
-        getattr(batch.slots, name)[rows] = getattr(slots, name)
-    batch._oscillation._history[rows] = mdp._oscillation._history[0]
-    if mdp._trail is not None and batch._trail is not None:
-        batch._trail.cells[rows] = mdp._trail.cells[0]
-    batch.steps[rows] = mdp.steps
-    batch.steps_without_progress[rows] = mdp.steps_without_progress
-    batch.done[rows] = False
-    last = mdp.last
-    if last is not None:
-        batch.targets[rows] = last.targets
-        batch.heading[rows] = mdp._heading(last.targets, last.move.reached)
-        batch.padding[rows] = last.padding
-        batch.oscillation[rows] = last.oscillation
-        batch.new_cells[rows] = last.move.new_cells
+    for name in source.slots.__slots__:
+        getattr(batch.slots, name)[rows] = getattr(source.slots, name)[index]
+    batch.packed[rows] = source.packed[index]
+    batch._oscillation.history[rows] = source._oscillation.history[index]
+    if source._trail is not None and batch._trail is not None:
+        batch._trail.cells[rows] = source._trail.cells[index]
+    for name in _DECISIONS:
+        getattr(batch, name)[rows] = getattr(source, name)[index]
     return batch

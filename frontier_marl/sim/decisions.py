@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.sim.rewards import oscillation_step
+from frontier_marl.sim.rewards import oscillation_step, reward_table
 
 
 @compiled
@@ -78,6 +78,25 @@ def count_progress(
 
 
 @compiled
+def world_events(
+    fraction: np.ndarray,
+    threshold: float,
+    live: np.ndarray,
+    threshold_reached: np.ndarray,
+    no_frontier_left: np.ndarray,
+) -> None:
+    """The reward table's per-world events of W worlds after a step: ``threshold_reached``
+    (W,) where the explored ``fraction`` (W,) is at least ``threshold``, ``no_frontier_left``
+    where no robot has a live slot (``live`` (W, N))."""
+    for w in range(len(fraction)):
+        threshold_reached[w] = fraction[w] >= threshold
+        left = False
+        for n in range(live.shape[1]):
+            left = left or live[w, n] > 0
+        no_frontier_left[w] = not left
+
+
+@compiled
 def settle(
     active: np.ndarray,
     targets: np.ndarray,
@@ -110,3 +129,46 @@ def settle(
         kept_targets[w] = targets[w]
         kept_padding[w] = padding[w]
         kept_oscillation[w] = oscillation[w]
+
+
+@compiled
+def finish_step(
+    constants: np.ndarray,
+    travel: bool,
+    padding_truncates: bool,
+    no_progress_limit: int,
+    max_steps: int,
+    fraction: np.ndarray,
+    explore_threshold: float,
+    live: np.ndarray,
+    new_cells: np.ndarray,
+    steps: np.ndarray,
+    without_progress: np.ndarray,
+    moved: np.ndarray,
+    events: tuple[np.ndarray, np.ndarray],
+    active: np.ndarray,
+    targets: np.ndarray,
+    reached: np.ndarray,
+    padding: np.ndarray,
+    oscillation: np.ndarray,
+    outcome: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    done: np.ndarray,
+    kept: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """The end of a step in one compiled call: :func:`world_events` into ``events``, the
+    reward table (:func:`~frontier_marl.sim.rewards.reward_table`, its first five arguments
+    from :func:`~frontier_marl.sim.rewards.table_constants`) into ``outcome`` (rewards,
+    terminated, truncated, reason), then :func:`settle` with ``kept`` (targets, heading,
+    padding, oscillation)."""
+    threshold_reached, no_frontier_left = events
+    rewards, terminated, truncated, reason = outcome
+    world_events(fraction, explore_threshold, live, threshold_reached, no_frontier_left)
+    reward_table(
+        constants, travel, padding_truncates, no_progress_limit, max_steps, new_cells, padding,
+        oscillation, threshold_reached, no_frontier_left, steps, without_progress, moved,
+        rewards, terminated, truncated, reason,
+    )  # fmt: skip
+    settle(
+        active, targets, reached, padding, oscillation, rewards, terminated, truncated, reason,
+        done, *kept,
+    )  # fmt: skip

@@ -180,7 +180,7 @@ def batch_outcome(
     arrays of integers or bools, as they come: converting them cost more than the table);
     ``moved`` (cells walked) is needed by the ``travel`` reward only. The outcome is written
     into ``out`` when given (arrays of those shapes), into fresh arrays otherwise."""
-    constants, travel, padding_truncates, no_progress_limit, max_steps = _constants(cfg)
+    constants, travel, padding_truncates, no_progress_limit, max_steps = table_constants(cfg)
     if travel and moved is None:
         raise ValueError("the travel reward needs the cells each robot walked")
     worlds, robots = new_cells.shape
@@ -190,7 +190,7 @@ def batch_outcome(
         np.empty(worlds, dtype=bool),
         np.empty(worlds, dtype=np.int64),
     )
-    _reward_table(
+    reward_table(
         constants,
         travel,
         padding_truncates,
@@ -217,8 +217,8 @@ def batch_outcome(
 _CONSTANTS: dict[int, tuple[RewardConfig, tuple[np.ndarray, bool, bool, int, int]]] = {}
 
 
-def _constants(cfg: RewardConfig) -> tuple[np.ndarray, bool, bool, int, int]:
-    """The reward table's constants, in :func:`_reward_table`'s order: the float array, the
+def table_constants(cfg: RewardConfig) -> tuple[np.ndarray, bool, bool, int, int]:
+    """The reward table's constants, in :func:`reward_table`'s order: the float array, the
     travel and padding-truncation switches, the no-progress and step limits."""
     cached = _CONSTANTS.get(id(cfg))
     if cached is not None and cached[0] is cfg:
@@ -250,7 +250,7 @@ def _table_constants(cfg: RewardConfig) -> np.ndarray:
 
 
 @compiled
-def _reward_table(
+def reward_table(
     constants: np.ndarray,
     travel: bool,
     padding_truncates: bool,

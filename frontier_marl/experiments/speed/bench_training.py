@@ -30,10 +30,10 @@ import stable_baselines3
 from scipy import ndimage
 from stable_baselines3 import DQN
 
-from frontier_marl.core import world
+from frontier_marl.core import worlds
 from frontier_marl.envs import parallel
 from frontier_marl.envs.parallel import FrontierParallelEnv
-from frontier_marl.sim import engine
+from frontier_marl.sim import batch_engine, engine
 from frontier_marl.training import vec_env as vec_module
 from frontier_marl.training.experiment import Experiment, load_experiment
 from frontier_marl.training.results import TrainResult
@@ -66,11 +66,11 @@ class Timer:
 def stage_functions() -> list[tuple[object, str]]:
     """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
     return [
-        (world.World, "move"),  # planning, walking, sensing
-        (engine.ExplorationMDP, "_refresh_slots"),  # clusters (with ndimage.label) and slots
+        (worlds.Worlds, "move"),  # planning, walking, sensing
+        (worlds.Worlds, "slots"),  # clusters (with ndimage.label) and slots
         (ndimage, "label"),
-        (engine.ExplorationMDP, "_observations"),
-        (engine, "batch_outcome"),  # the reward table
+        (batch_engine.BatchMDP, "observations"),
+        (batch_engine, "finish_step"),  # the reward table and the end of the step
         (parallel, "build_infos"),  # the info dicts
         (engine.ExplorationMDP, "reset"),
     ]

@@ -38,10 +38,9 @@ PARTS = (
     ("clusters (masks, scipy label, cluster stats)", "slots", "worlds.refresh_clusters"),
     ("all_slots (distance fields, slot tables)", "slots", "kernels.all_slots"),
     ("explored fraction", "mdp.step", "worlds.explored_fraction"),
-    ("reward table", "mdp.step", "engine.batch_outcome"),
     ("count_progress", "mdp.step", "engine.count_progress"),
-    ("settle", "mdp.step", "engine.settle"),
-    ("observations", "step", "mdp.observations"),
+    ("reward table and settle", "mdp.step", "engine.finish_step"),
+    ("observations", "step", "mdp.robot_observations"),
     ("encoder", "observations", "encoder.encode_batch"),
     ("autoresets", "step", "mdp.reset_worlds"),
 )
