@@ -414,3 +414,18 @@ def test_world_invariants_under_random_play(
         assert result.new_cells.sum() == known_after - known_before
         assert (result.new_cells >= 0).all()
         known = _check_state(world, known)
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    shape=st.tuples(st.integers(1, 4), st.integers(1, 9), st.integers(1, 9)),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_known_and_free_cell_counts_are_numpys(shape, seed) -> None:
+    from frontier_marl.core.world_kernels import count_states
+
+    belief = np.random.default_rng(seed).integers(-1, 2, shape).astype(np.int8)
+    known = np.count_nonzero(belief != UNKNOWN, axis=(1, 2))
+    free = np.count_nonzero(belief == FREE, axis=(1, 2))
+    assert np.array_equal(count_states(belief, False), known)
+    assert np.array_equal(count_states(belief, True), free)

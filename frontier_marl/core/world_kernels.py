@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.grid import UNKNOWN
+from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slots import _pack, _robot_slots
 
@@ -145,6 +145,21 @@ def count_known(belief: np.ndarray, region: np.ndarray) -> np.ndarray:
         for r in range(belief.shape[1]):
             for c in range(belief.shape[2]):
                 if region[n, r, c] and belief[n, r, c] != UNKNOWN:
+                    count += 1
+        out[n] = count
+    return out
+
+
+@compiled
+def count_states(belief: np.ndarray, free_only: bool) -> np.ndarray:
+    """Per world, the known cells of ``belief`` (the free ones only with ``free_only``)."""
+    out = np.zeros(belief.shape[0], dtype=np.int64)
+    for n in range(belief.shape[0]):
+        count = 0
+        for r in range(belief.shape[1]):
+            for c in range(belief.shape[2]):
+                state = belief[n, r, c]
+                if state == FREE if free_only else state != UNKNOWN:
                     count += 1
         out[n] = count
     return out

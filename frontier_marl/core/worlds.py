@@ -26,12 +26,18 @@ from frontier_marl.core.frontiers import (
     label_tiled,
     unknown_around,
 )
-from frontier_marl.core.grid import FREE, UNKNOWN
+from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.planning import path_search_scratch
 from frontier_marl.core.sensing import Sensor, reveal
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays
-from frontier_marl.core.world_kernels import all_slots, count_known, settle_clusters, walk_worlds
+from frontier_marl.core.world_kernels import (
+    all_slots,
+    count_known,
+    count_states,
+    settle_clusters,
+    walk_worlds,
+)
 
 FULL_PATH = -1  # ``cells_per_step`` value meaning "walk the whole path"
 
@@ -269,9 +275,9 @@ class Worlds:
     def _explored_fraction(self, basis: str) -> np.ndarray:
         belief = self.belief
         if basis == "all":
-            return np.count_nonzero(belief != UNKNOWN, axis=(1, 2)) / belief[0].size
+            return count_states(belief, False) / belief[0].size
         if basis == "free":
-            return np.count_nonzero(belief == FREE, axis=(1, 2)) / np.maximum(self.true_free, 1)
+            return count_states(belief, True) / np.maximum(self.true_free, 1)
         if basis == "reachable":
             known = count_known(belief, self.start_region)
             return known / np.maximum(self.start_region_size, 1)
