@@ -51,6 +51,10 @@ def test_labelling_benchmark_counts(tmp_path: Path) -> None:
     assert 0 < rollout["labellings"] <= 300 + 300  # at most one per step and one per reset
     assert 0 <= rollout["same_frontier"] < rollout["labellings"]
     assert all(cost > 0 for cost in report["us_per_call"].values())
+    assert list(report["tiled_vs_stacked"]) == [
+        f"{n} x {s}x{s}" for n, s in bench_labelling.BATCHES
+    ]
+    assert all(row["tiled_us"] > 0 for row in report["tiled_vs_stacked"].values())
     from scipy import ndimage
 
     from frontier_marl.core import frontiers

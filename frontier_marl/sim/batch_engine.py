@@ -1,13 +1,13 @@
-"""The decision process of N worlds stepped together, for the batched vector env.
+"""The decision process: the package's only implementation of a step, for N worlds at once.
 
 :class:`BatchMDP` holds N episodes of ``cfg.n_agents`` robots in shared arrays
-(:class:`~frontier_marl.core.worlds.Worlds`) and applies the rules of
-:class:`~frontier_marl.sim.engine.ExplorationMDP` to all of them at once: actions become targets,
+(:class:`~frontier_marl.core.worlds.Worlds`) and steps them together: actions become targets,
 one compiled call walks every robot, the frontier masks of all worlds whose belief changed are
-labelled by one ``scipy.ndimage.label`` call, one compiled call builds every robot's slots, and
-the reward table, the oscillation test and the observation encoder run on whole arrays. World
-``i`` draws its episodes from its own ``numpy.random.Generator``, so with the same generator
-it plays exactly the episodes of the single-world engine.
+labelled by one ``scipy.ndimage.label`` call, one compiled call builds every robot's slots, one
+applies the reward table and the episode ends, and the observation encoder runs on whole
+arrays. World ``i`` draws its episodes from its own ``numpy.random.Generator``. The vector env
+and the SB3 batched adapter use it directly; the single env's
+:class:`~frontier_marl.sim.engine.ExplorationMDP` is a batch of one.
 """
 
 from __future__ import annotations

@@ -10,6 +10,9 @@ at each rule weight of ``--weights`` (k = 1 is one plain fit)::
 
     python benchmarks/explorer_map_ensemble.py runs/explorer-map-r0 --sizes 1,4,8 \\
         --weights 0,0.5,1 --episodes 16 --json ensemble.json
+
+``--set KEY=VALUE`` changes a fit setting of the run's ``[regression]`` section (e.g.
+``--set scorer_width=64`` for a wider scorer).
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (
 )
 from frontier_marl.training.cost_regression import Validation, fitted
 from frontier_marl.training.cost_to_go import Samples
+from frontier_marl.training.experiment import parse_override
 from frontier_marl.training.settings import RegressionSettings
 from frontier_marl.utils.progress import progress_bar
 
@@ -53,6 +57,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--weights", default="0,0.5,1", help="rule weights, comma-separated")
     parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
     parser.add_argument("--epochs", type=int, default=None, help="default: the run's")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a fit setting of [regression] instead of the run's (e.g. scorer_width=64)",
+    )
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
@@ -68,7 +80,15 @@ def main(argv: list[str] | None = None) -> int:
     settings = dict(experiment.regression)
     if args.epochs is not None:
         settings["fit_epochs"] = args.epochs
-    reg = RegressionSettings(**settings)
+    try:
+        for text in args.overrides:
+            section, key, value = parse_override(text)
+            if section != "regression":
+                raise ValueError(f"--set takes [regression] settings only, got {text!r}")
+            settings[key] = value
+        reg = RegressionSettings(**settings)
+    except (ValueError, TypeError) as exc:
+        parser.error(str(exc))
     seed = experiment.train.seed
     members = []
     with progress_bar(max(sizes), disable=args.no_progress, desc="fits", unit="fit") as bar:
