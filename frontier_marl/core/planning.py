@@ -55,8 +55,18 @@ def distance_field(grid: np.ndarray, free: Any, row: int, col: int) -> np.ndarra
     """Shortest 4-connected path length from (row, col) to every cell where ``grid == free``
     (int64, -1 where unreachable); the source counts as reached even where it is not free."""
     height, width = grid.shape
-    dist = np.full((height, width), -1, dtype=np.int64)
-    queue = np.empty(height * width, dtype=np.int64)
+    dist = np.empty((height, width), dtype=np.int64)
+    fill_distance_field(grid, free, row, col, dist, np.empty(height * width, dtype=np.int64))
+    return dist
+
+
+@compiled
+def fill_distance_field(
+    grid: np.ndarray, free: Any, row: int, col: int, dist: np.ndarray, queue: np.ndarray
+) -> None:
+    """:func:`distance_field` into ``dist`` (H, W), with ``queue`` (H W,) as scratch."""
+    height, width = grid.shape
+    dist[:] = -1
     queue[0] = row * width + col
     dist[row, col] = 0
     head, tail = 0, 1
@@ -70,7 +80,6 @@ def distance_field(grid: np.ndarray, free: Any, row: int, col: int) -> np.ndarra
                 dist[nr, nc] = d
                 queue[tail] = nr * width + nc
                 tail += 1
-    return dist
 
 
 @compiled

@@ -24,7 +24,7 @@ import numpy as np
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.frontiers import Clusters
 from frontier_marl.core.grid import FREE
-from frontier_marl.core.planning import distance_field
+from frontier_marl.core.planning import fill_distance_field
 
 _ARRAYS = ("cluster", "valid", "centroid", "target", "distance", "size", "gain", "path_length")
 _FIELDS = (*_ARRAYS, "mask")
@@ -335,9 +335,55 @@ def _robot_slots(
     np.ndarray,
     int,
 ]:
-    """The fields of :class:`SlotTable` for the robot at (row, col): reachability and path
-    lengths from one distance field, targets, selection of the nearest, order, padding."""
-    field = distance_field(belief, FREE, row, col)
+    """The fields of :class:`SlotTable` for the robot at (row, col), in fresh arrays
+    (:func:`_robot_slots_into`)."""
+    cluster = np.empty(n_slots, dtype=np.int64)
+    valid = np.empty(n_slots, dtype=np.bool_)
+    centroid = np.empty((n_slots, 2))
+    target = np.empty((n_slots, 2), dtype=np.int64)
+    slot_distance = np.empty(n_slots)
+    size = np.empty(n_slots, dtype=np.int64)
+    gain = np.empty(n_slots)
+    path_length = np.empty(n_slots, dtype=np.int64)
+    mask = np.empty(n_slots, dtype=np.int8)
+    live = _robot_slots_into(
+        belief, row, col, rows, cols, cell_cluster, centroids, sizes, gains, sort,
+        np.empty(belief.shape, dtype=np.int64), np.empty(belief.size, dtype=np.int64),
+        cluster, valid, centroid, target, slot_distance, size, gain, path_length, mask,
+    )  # fmt: skip
+    return cluster, valid, centroid, target, slot_distance, size, gain, path_length, mask, live
+
+
+@compiled
+def _robot_slots_into(
+    belief: np.ndarray,
+    row: int,
+    col: int,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    cell_cluster: np.ndarray,
+    centroids: np.ndarray,
+    sizes: np.ndarray,
+    gains: np.ndarray,
+    sort: bool,
+    field: np.ndarray,
+    queue: np.ndarray,
+    cluster: np.ndarray,
+    valid: np.ndarray,
+    centroid: np.ndarray,
+    target: np.ndarray,
+    slot_distance: np.ndarray,
+    size: np.ndarray,
+    gain: np.ndarray,
+    path_length: np.ndarray,
+    mask: np.ndarray,
+) -> int:
+    """The fields of :class:`SlotTable` for the robot at (row, col) into the given arrays (their
+    length is the number of slots; ``field`` (H, W) and ``queue`` (H W,) are scratch); returns
+    the number of live slots. Reachability and path lengths come from one distance field,
+    then targets, selection of the nearest, order, padding."""
+    n_slots = len(cluster)
+    fill_distance_field(belief, FREE, row, col, field, queue)
     eligible = np.empty(len(rows), dtype=np.bool_)
     for i in range(len(rows)):
         eligible[i] = field[rows[i], cols[i]] >= 0
@@ -354,14 +400,14 @@ def _robot_slots(
         order = np.argsort(distance, kind="mergesort")
         live = live[order]
         distance = distance[order]
-    cluster = np.full(n_slots, -1, dtype=np.int64)
-    valid = np.zeros(n_slots, dtype=np.bool_)
-    centroid = np.zeros((n_slots, 2))
-    target = np.full((n_slots, 2), -1, dtype=np.int64)
-    slot_distance = np.zeros(n_slots)
-    size = np.zeros(n_slots, dtype=np.int64)
-    gain = np.zeros(n_slots)
-    path_length = np.full(n_slots, -1, dtype=np.int64)
+    cluster[:] = -1
+    valid[:] = False
+    centroid[:] = 0.0
+    target[:] = -1
+    slot_distance[:] = 0.0
+    size[:] = 0
+    gain[:] = 0.0
+    path_length[:] = -1
     for slot in range(len(live)):
         k = live[slot]
         cluster[slot] = k
@@ -374,8 +420,8 @@ def _robot_slots(
         size[slot] = sizes[k]
         gain[slot] = gains[k]
         path_length[slot] = field[targets[k, 0], targets[k, 1]]
-    mask = np.zeros(n_slots, dtype=np.int8)
+    mask[:] = 0
     mask[: len(live)] = 1
     if len(live) == 0:
         mask[0] = 1
-    return cluster, valid, centroid, target, slot_distance, size, gain, path_length, mask, len(live)
+    return len(live)

@@ -9,7 +9,7 @@ import numpy as np
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.movement import walk
-from frontier_marl.core.slots import _pack, _robot_slots
+from frontier_marl.core.slots import _pack, _robot_slots_into
 
 
 @compiled
@@ -90,7 +90,6 @@ def all_slots(
     sizes: np.ndarray,
     gains: np.ndarray,
     n_clusters: np.ndarray,
-    n_slots: int,
     sort: bool,
     cluster: np.ndarray,
     valid: np.ndarray,
@@ -104,13 +103,15 @@ def all_slots(
     live: np.ndarray,
     packed: np.ndarray,
 ) -> None:
-    """:func:`~frontier_marl.core.slots._robot_slots` of every robot of ``worlds``, into the
+    """:func:`~frontier_marl.core.slots._robot_slots_into` of every robot of ``worlds``, into the
     outputs, and the same slots packed (:meth:`~frontier_marl.core.slots.SlotArrays.packed`)
     into ``packed`` (N, K, S, 10)."""
+    field = np.empty(belief.shape[1:], dtype=np.int64)  # the distance fields' scratch
+    queue = np.empty(belief.shape[1] * belief.shape[2], dtype=np.int64)
     for n in worlds:
         cells, count = n_cells[n], n_clusters[n]
         for k in range(positions.shape[1]):
-            result = _robot_slots(
+            live[n, k] = _robot_slots_into(
                 belief[n],
                 positions[n, k, 0],
                 positions[n, k, 1],
@@ -120,20 +121,23 @@ def all_slots(
                 centroids[n, :count],
                 sizes[n, :count],
                 gains[n, :count],
-                n_slots,
                 sort,
+                field,
+                queue,
+                cluster[n, k],
+                valid[n, k],
+                centroid[n, k],
+                target[n, k],
+                distance[n, k],
+                size[n, k],
+                gain[n, k],
+                path_length[n, k],
+                mask[n, k],
             )
-            cluster[n, k] = result[0]
-            valid[n, k] = result[1]
-            centroid[n, k] = result[2]
-            target[n, k] = result[3]
-            distance[n, k] = result[4]
-            size[n, k] = result[5]
-            gain[n, k] = result[6]
-            path_length[n, k] = result[7]
-            mask[n, k] = result[8]
-            live[n, k] = result[9]
-            _pack(*result[:5], result[7], result[5], result[6], packed[n, k])
+            _pack(
+                cluster[n, k], valid[n, k], centroid[n, k], target[n, k], distance[n, k],
+                path_length[n, k], size[n, k], gain[n, k], packed[n, k],
+            )  # fmt: skip
 
 
 @compiled

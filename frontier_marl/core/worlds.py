@@ -245,7 +245,6 @@ class Worlds:
             self.sizes,
             self.gains,
             self.n_clusters,
-            out.cluster.shape[-1],
             sort_by_distance,
             out.cluster,
             out.valid,
