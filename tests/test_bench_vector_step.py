@@ -22,3 +22,11 @@ def test_the_breakdown_reports_every_part_and_restores_the_env(tmp_path: Path) -
     slots = "all_slots (distance fields, slot tables)"
     assert per_step["step"] > per_step["mdp.step"] > per_step["slots"] > per_step[slots]
     assert (batch_engine.decide, batch_engine.finish_step, worlds_module.all_slots) == kernels
+
+
+def test_the_interleaved_step_cost_reports_both_figures() -> None:
+    from frontier_marl.experiments.speed.bench_vector_env import interleaved_step_cost
+
+    cost = interleaved_step_cost(2, 20, rounds=1)
+    assert cost["n_envs"] == 2
+    assert cost["us_per_step_alone"] > 0 and cost["us_per_step_interleaved"] > 0

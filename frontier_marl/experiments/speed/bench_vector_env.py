@@ -13,7 +13,8 @@
 2. **The env's share of training time**: DQN (the thesis's hyperparameters, configuration 1's
    observation) on the batched env with 8 worlds, and PPO on 16, each against a null vector env
    with identical spaces, the two trainings interleaved in chunks (env share =
-   (T_env - T_null) / T_env).
+   (T_env - T_null) / T_env); and the CPU time of one step of the 8-world env alone and between
+   DQN's own work (:func:`interleaved_step_cost`).
 
 SB3, SuperSuit and torch (the train extra) are imported where they are used: the batched
 env's rates (:func:`rate_batched`, which ``bench_explorer_features`` uses) need none of them.
@@ -286,6 +287,47 @@ def training_share(algorithm: str, n_envs: int, steps: int, chunks: int) -> dict
     }
 
 
+def interleaved_step_cost(n_envs: int, steps: int, rounds: int = 3) -> dict[str, Any]:
+    """CPU microseconds per ``step`` of the batched env (``n_envs`` worlds, random slots), alone
+    and with DQN's own work between the steps (action selection every step, a gradient step
+    every 4, as in training): what the env costs inside training beyond its own work. Each
+    figure is the median of ``rounds`` alternated rounds."""
+    import torch
+
+    from frontier_marl.training.batched_vec_env import make_batched_vec_env
+
+    torch.set_num_threads(1)
+    env = make_batched_vec_env({"config": make_config(**CONFIG01)}, n_envs, seed=0)
+    model = _model("dqn", env)
+    model.learn(1100)  # past learning_starts: the replay buffer can be sampled
+    rng = np.random.default_rng(0)
+    state = {"obs": env.reset()}
+
+    def step_us(interleaved: bool) -> float:
+        spent = 0.0
+        for i in range(steps):
+            if interleaved:
+                model.predict(state["obs"], deterministic=False)
+                if i % 4 == 0:
+                    model.train(gradient_steps=1, batch_size=64)
+            actions = random_valid(env.venv.action_masks(), rng)
+            start = time.thread_time()
+            env.step_async(actions)
+            state["obs"] = env.step_wait()[0]
+            spent += time.thread_time() - start
+        return spent / steps * 1e6
+
+    alone, interleaved = [], []
+    for _ in range(rounds):
+        alone.append(step_us(False))
+        interleaved.append(step_us(True))
+    return {
+        "n_envs": n_envs,
+        "us_per_step_alone": float(np.median(alone)),
+        "us_per_step_interleaved": float(np.median(interleaved)),
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=3.0, help="timed seconds per figure")
@@ -312,6 +354,12 @@ def main(argv: list[str] | None = None) -> int:
                 f"{row['seconds_null']:.1f} s, env {row['seconds_env']:.1f} s; env share "
                 f"{100 * row['env_share']:.1f} % "
                 f"(standard error {100 * row['env_share_standard_error']:.1f})"
+            )
+        if args.dqn_steps:
+            cost = report["interleaved"] = interleaved_step_cost(8, 2000)
+            print(
+                f"batched env step, 8 worlds: {cost['us_per_step_alone']:.0f} µs CPU alone, "
+                f"{cost['us_per_step_interleaved']:.0f} µs between DQN's network work"
             )
     if args.json:
         with open(args.json, "w") as handle:
