@@ -1,6 +1,7 @@
-"""Actions to targets: the compiled calls that turn slot choices into the cells the robots head
-for (with the padding flags and the oscillation test), and tell where they still head after
-the walk, for a batch of worlds. Outputs are passed in: numba boxes returned arrays slowly."""
+"""The engine's compiled calls around the walk, for a batch of worlds: actions to targets (with
+the padding flags and the oscillation test), the step counters, and the end of a step (the
+reward table, the episode ends, where each robot still heads). Outputs are passed in: numba
+boxes returned arrays slowly."""
 
 from __future__ import annotations
 
