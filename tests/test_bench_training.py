@@ -29,7 +29,7 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
     assert stages["reset"]["calls"] >= 1
     # The stages run inside the env step, so together they take less time than it does.
     inside_step = sum(stages[k]["us_per_env_step"] for k in stages if k not in ("reset",))
-    inside_step -= stages["ndimage.label"]["us_per_env_step"]  # part of _refresh_slots
+    inside_step -= stages["ndimage.label"]["us_per_env_step"]  # part of Worlds.slots
     assert 0 < inside_step < report["us_per_env_step"] + 1.0
 
 
