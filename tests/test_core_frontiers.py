@@ -16,7 +16,7 @@ from frontier_marl.core.frontiers import (
     unknown_around,
 )
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
-from frontier_marl.core.slots import nearest_targets
+from frontier_marl.core.slot_kernels import nearest_targets
 from tests import oracles
 
 _CODES = {"?": UNKNOWN, ".": FREE, "#": OCCUPIED}

@@ -9,7 +9,8 @@ import numpy as np
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.movement import walk
-from frontier_marl.core.slots import _pack, _robot_slots_into
+from frontier_marl.core.slot_kernels import fill_robot_slots
+from frontier_marl.core.slots import _pack
 
 
 @compiled
@@ -103,15 +104,15 @@ def all_slots(
     live: np.ndarray,
     packed: np.ndarray,
 ) -> None:
-    """:func:`~frontier_marl.core.slots._robot_slots_into` of every robot of ``worlds``, into the
-    outputs, and the same slots packed (:meth:`~frontier_marl.core.slots.SlotArrays.packed`)
-    into ``packed`` (N, K, S, 10)."""
+    """:func:`~frontier_marl.core.slot_kernels.fill_robot_slots` of every robot of ``worlds``,
+    into the outputs, and the same slots packed
+    (:meth:`~frontier_marl.core.slots.SlotArrays.packed`) into ``packed`` (N, K, S, 10)."""
     field = np.empty(belief.shape[1:], dtype=np.int64)  # the distance fields' scratch
     queue = np.empty(belief.shape[1] * belief.shape[2], dtype=np.int64)
     for n in worlds:
         cells, count = n_cells[n], n_clusters[n]
         for k in range(positions.shape[1]):
-            live[n, k] = _robot_slots_into(
+            live[n, k] = fill_robot_slots(
                 belief[n],
                 positions[n, k, 0],
                 positions[n, k, 1],

@@ -76,7 +76,6 @@ class BatchMDP:
         self._chosen = (np.empty((n, k, 2), dtype=np.int64), *chosen_flags)
         self._before = np.empty((n, k), dtype=np.int64)
         self._travel = cfg.reward.kind == "travel"  # the only reward that reads the cells walked
-        self._events = (np.empty(n, dtype=bool), np.empty(n, dtype=bool))  # see world_events
         self._kept = (self.targets, self.heading, self.padding, self.oscillation)  # see settle
 
     def _make_views(self) -> None:
@@ -150,7 +149,7 @@ class BatchMDP:
         finish_step(
             *table_constants(reward), fraction, reward.explore_threshold, slots.live, new_cells,
             self.steps, self.steps_without_progress,
-            worlds.travelled - self._before if self._travel else new_cells, self._events, active,
+            worlds.travelled - self._before if self._travel else new_cells, active,
             targets, worlds.reached, padding, oscillation,
             (ends.rewards, ends.terminated, ends.truncated, ends.reason), self.done, self._kept,
         )  # fmt: skip

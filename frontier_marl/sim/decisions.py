@@ -146,7 +146,6 @@ def finish_step(
     steps: np.ndarray,
     without_progress: np.ndarray,
     moved: np.ndarray,
-    events: tuple[np.ndarray, np.ndarray],
     active: np.ndarray,
     targets: np.ndarray,
     reached: np.ndarray,
@@ -156,12 +155,13 @@ def finish_step(
     done: np.ndarray,
     kept: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
 ) -> None:
-    """The end of a step in one compiled call: :func:`world_events` into ``events``, the
+    """The end of a step in one compiled call: :func:`world_events`, the
     reward table (:func:`~frontier_marl.sim.rewards.reward_table`, its first five arguments
     from :func:`~frontier_marl.sim.rewards.table_constants`) into ``outcome`` (rewards,
     terminated, truncated, reason), then :func:`settle` with ``kept`` (targets, heading,
     padding, oscillation)."""
-    threshold_reached, no_frontier_left = events
+    threshold_reached = np.empty(len(fraction), dtype=np.bool_)
+    no_frontier_left = np.empty(len(fraction), dtype=np.bool_)
     rewards, terminated, truncated, reason = outcome
     world_events(fraction, explore_threshold, live, threshold_reached, no_frontier_left)
     reward_table(

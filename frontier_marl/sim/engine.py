@@ -69,7 +69,6 @@ class ExplorationMDP:
         self._tables: list[SlotTable] | None = None  # views of the slots, made when asked
         self._agents = range(cfg.n_agents)
         self._make_views()
-        self._read_counters()
 
     def _make_views(self) -> None:
         """The batch's slots as views of its only world, made once (and again after a copy:
@@ -84,13 +83,22 @@ class ExplorationMDP:
         self.__dict__.update(state)
         self._make_views()
 
-    def _read_counters(self) -> None:
-        """The batch's step counters, end flag and explored fraction, as plain numbers."""
-        batch = self.batch
-        self.steps = int(batch.steps[0])
-        self.steps_without_progress = int(batch.steps_without_progress[0])
-        self.done = bool(batch.done[0])
-        self.explored = float(batch.explored[0])  # on the reward's threshold basis
+    @property
+    def steps(self) -> int:
+        return int(self.batch.steps[0])
+
+    @property
+    def steps_without_progress(self) -> int:
+        return int(self.batch.steps_without_progress[0])
+
+    @property
+    def done(self) -> bool:
+        return bool(self.batch.done[0])
+
+    @property
+    def explored(self) -> float:
+        """The explored fraction on the reward's threshold basis, now."""
+        return float(self.batch.explored[0])
 
     # ------------------------------------------------------------------ episode
     def reset(self, rng: np.random.Generator) -> list[Observation]:
@@ -101,7 +109,6 @@ class ExplorationMDP:
             self.world = World.of(self.batch.worlds, 0)
         self.last = None
         self._tables = None
-        self._read_counters()
         return self._observations()
 
     def step(self, actions: list[Any]) -> StepResult:
@@ -118,7 +125,6 @@ class ExplorationMDP:
         batch = self.batch
         batch.step(slots, _ONE)
         self._tables = None
-        self._read_counters()
         self.last = StepResult(
             self._observations(),
             batch.targets[0].copy(),

@@ -7,7 +7,7 @@ union-find over the frontier cells alone (numbered as ``scipy.ndimage.label`` nu
 from a frontier mask the caller keeps up to date where the belief changed (both in
 :mod:`frontier_marl.core.frontier_union`). It finds the slot nearest by path with a
 breadth-first search that stops as soon as the answer is sure; when it cannot be, it builds
-the slots as the env does (:func:`~frontier_marl.core.slots._robot_slots`) and takes
+the slots as the env does (:func:`~frontier_marl.core.slot_kernels.robot_slot_fields`) and takes
 :func:`nearest_path` of them.
 """
 
@@ -19,7 +19,7 @@ from frontier_marl.core.compiled import compiled
 from frontier_marl.core.frontier_union import label_frontier_cells, update_frontier
 from frontier_marl.core.frontiers import cluster_stats, split_and_renumber
 from frontier_marl.core.grid import FREE
-from frontier_marl.core.slots import _robot_slots, nearest_targets
+from frontier_marl.core.slot_kernels import nearest_targets, robot_slot_fields
 
 
 class DecisionScratch:
@@ -107,7 +107,7 @@ def nearest_path_goal(
         )
         if goal[0] != -2:
             return goal
-    result = _robot_slots(
+    result = robot_slot_fields(
         belief, row, col, cell_rows, cell_cols, cluster, centroids, sizes,
         sizes.astype(np.float64), n_slots, False,
     )  # fmt: skip
