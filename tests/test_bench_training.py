@@ -17,19 +17,17 @@ def test_stage_report_is_consistent(tmp_path: Path) -> None:
     assert abs(sum(shares) - 1.0) < 0.01  # env + vector layers + gradient steps + rest
     stages = report["stages"]
     assert set(stages) == {
-        "move",
-        "slots",
-        "ndimage.label",
+        "before_labelling",
+        "label_stale",
+        "after_labelling",
         "observations",
-        "finish_step",
         "build_infos",
         "reset",
     }
-    assert stages["move"]["calls"] == 600 - 1  # one per env step, the first left out
+    assert stages["before_labelling"]["calls"] == 600 - 1  # one per env step, the first left out
     assert stages["reset"]["calls"] >= 1
     # The stages run inside the env step, so together they take less time than it does.
     inside_step = sum(stages[k]["us_per_env_step"] for k in stages if k not in ("reset",))
-    inside_step -= stages["ndimage.label"]["us_per_env_step"]  # part of Worlds.slots
     assert 0 < inside_step < report["us_per_env_step"] + 1.0
 
 
@@ -37,9 +35,16 @@ def test_benchmark_leaves_the_env_unpatched(tmp_path: Path) -> None:
     from frontier_marl.core import worlds
     from frontier_marl.sim import batch_engine, engine
 
-    before = (worlds.Worlds.move, batch_engine.finish_step, engine.ExplorationMDP.reset)
+    def patchable() -> tuple[object, ...]:
+        return (
+            worlds.Worlds.label_stale,
+            batch_engine.after_labelling,
+            engine.ExplorationMDP.reset,
+        )
+
+    before = patchable()
     bench_training.main(["config01", "--steps", "200", "--stages"])
-    assert (worlds.Worlds.move, batch_engine.finish_step, engine.ExplorationMDP.reset) == before
+    assert patchable() == before
 
 
 def test_labelling_benchmark_counts(tmp_path: Path) -> None:

@@ -116,6 +116,7 @@ def test_a_clone_of_any_world_of_a_batch_steps_as_that_world() -> None:
         play(source, ~source.done)
     assert not source.done[1]
     clones = clone_mdp(source, 1, 2)
+    assert np.array_equal(clones.explored, np.repeat(source.explored[1], 2))
     only_one = np.array([False, True, False])
     for _ in range(4):
         if source.done[1]:
@@ -131,6 +132,32 @@ def test_a_clone_of_any_world_of_a_batch_steps_as_that_world() -> None:
             assert clones.done[row] == source.done[1]
             for key, value in mine.items():
                 assert np.array_equal(theirs[key][row], value[0]), key
+
+
+@pytest.mark.parametrize("basis", ["all", "free", "reachable"])
+def test_a_step_counts_the_explored_fraction_of_every_world_on_its_basis(basis: str) -> None:
+    """The step's compiled count (only worlds whose belief changed are recounted) equals a
+    count with numpy, world by world, also in worlds that wait or whose episode ended."""
+    from frontier_marl.config import make_config
+
+    cfg = make_config("thesis-20x20", threshold_basis=basis, gain="unknown")
+    batch = BatchMDP(cfg, 3)
+    batch.rngs = [np.random.default_rng(seed) for seed in (1, 2, 3)]
+    batch.reset_worlds(np.arange(3))
+    rng = np.random.default_rng(0)
+    w = batch.worlds
+    for step in range(40):
+        active = ~batch.done & (np.arange(3) != step % 3)  # one world waits each step
+        masks = batch.slots.mask
+        batch.step((rng.random(masks.shape) * masks).argmax(axis=2), active)
+        known = w.belief != UNKNOWN
+        counts = {
+            "all": known.sum(axis=(1, 2)) / known[0].size,
+            "free": (w.belief == FREE).sum(axis=(1, 2)) / (~w.true).sum(axis=(1, 2)),
+            "reachable": (known & w.start_region).sum(axis=(1, 2)) / w.start_region_size,
+        }
+        assert np.array_equal(batch.explored, counts[basis])
+        assert np.array_equal(w.explored_fraction(basis), counts[basis])
 
 
 def test_branch_mdp_needs_an_episode_in_progress() -> None:

@@ -262,6 +262,31 @@ def test_unknown_around_at_grid_border():
     np.testing.assert_array_equal(unknown_around(belief, clusters), [3, 3, 3])
 
 
+@settings(max_examples=60, deadline=None)
+@given(
+    shape=st.tuples(st.integers(1, 9), st.integers(1, 9)),
+    max_cells=st.integers(0, 4),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_unknown_around_is_the_distinct_unknown_neighbours_of_each_cluster(shape, max_cells, seed):
+    belief = np.random.default_rng(seed).integers(-1, 2, shape).astype(np.int8)
+    clusters = cluster_frontiers(belief, connectivity=8, max_cells=max_cells)
+    expected = []
+    for k in range(clusters.count):
+        around = {
+            (r + dr, c + dc)
+            for r, c in clusters.cells_of(k).tolist()
+            for dr in (-1, 0, 1)
+            for dc in (-1, 0, 1)
+            if (dr, dc) != (0, 0)
+            and 0 <= r + dr < shape[0]
+            and 0 <= c + dc < shape[1]
+            and belief[r + dr, c + dc] == UNKNOWN
+        }
+        expected.append(len(around))
+    assert unknown_around(belief, clusters).tolist() == expected
+
+
 # ----------------------------------------------------------------------------- targets
 def nearest_cells_to_centroids(clusters, eligible):
     return nearest_targets(

@@ -421,11 +421,17 @@ def test_world_invariants_under_random_play(
     shape=st.tuples(st.integers(1, 4), st.integers(1, 9), st.integers(1, 9)),
     seed=st.integers(0, 2**32 - 1),
 )
-def test_the_known_and_free_cell_counts_are_numpys(shape, seed) -> None:
-    from frontier_marl.core.world_kernels import count_states
+def test_the_explored_cell_counts_are_numpys(shape, seed) -> None:
+    from frontier_marl.core.world_kernels import basis_code, count_cells
 
-    belief = np.random.default_rng(seed).integers(-1, 2, shape).astype(np.int8)
-    known = np.count_nonzero(belief != UNKNOWN, axis=(1, 2))
-    free = np.count_nonzero(belief == FREE, axis=(1, 2))
-    assert np.array_equal(count_states(belief, False), known)
-    assert np.array_equal(count_states(belief, True), free)
+    rng = np.random.default_rng(seed)
+    belief = rng.integers(-1, 2, shape).astype(np.int8)
+    region = rng.random(shape) < 0.5
+    expected = {
+        "all": np.count_nonzero(belief != UNKNOWN, axis=(1, 2)),
+        "free": np.count_nonzero(belief == FREE, axis=(1, 2)),
+        "reachable": np.count_nonzero(region & (belief != UNKNOWN), axis=(1, 2)),
+    }
+    for basis, counts in expected.items():
+        code = basis_code(basis)
+        assert [count_cells(code, belief[n], region[n]) for n in range(len(belief))] == list(counts)

@@ -24,7 +24,6 @@ _STRUCTURES = {
     4: ndimage.generate_binary_structure(2, 1),
     8: ndimage.generate_binary_structure(2, 2),
 }
-_EIGHT_OFFSETS = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0)]
 
 
 @dataclass(slots=True)
@@ -123,20 +122,28 @@ def split_cells(rows: np.ndarray, cols: np.ndarray, max_cells: int) -> list[np.n
 
 def unknown_around(belief: np.ndarray, clusters: Clusters) -> np.ndarray:
     """Per cluster, the number of distinct unknown cells 8-adjacent to any of its cells."""
+    out = np.zeros(clusters.count, dtype=np.int64)
+    count_unknown_around(belief, clusters.cell_rows, clusters.cell_cols, clusters.cell_cluster, out)
+    return out
+
+
+@compiled
+def count_unknown_around(
+    belief: np.ndarray, rows: np.ndarray, cols: np.ndarray, cluster: np.ndarray, out: np.ndarray
+) -> None:
+    """:func:`unknown_around` of the clusters numbered 0..len(out)-1 whose cells are
+    (``rows``, ``cols``) with cluster ids ``cluster``, into ``out`` (added to its values)."""
     height, width = belief.shape
-    if clusters.count == 0:
-        return np.zeros(0, dtype=np.int64)
-    keys = []
-    unknown = belief == UNKNOWN
-    for dr, dc in _EIGHT_OFFSETS:
-        r = clusters.cell_rows + dr
-        c = clusters.cell_cols + dc
-        inside = (r >= 0) & (r < height) & (c >= 0) & (c < width)
-        hit = np.zeros_like(inside)
-        hit[inside] = unknown[r[inside], c[inside]]
-        keys.append(clusters.cell_cluster[hit] * (height * width) + r[hit] * width + c[hit])
-    distinct = np.unique(np.concatenate(keys))
-    return np.bincount(distinct // (height * width), minlength=clusters.count)
+    stamp = np.full((height, width), -1, dtype=np.int64)  # the last cluster that counted a cell
+    for i in np.argsort(cluster, kind="mergesort"):  # each cluster's cells one after another
+        k = cluster[i]
+        for dr in range(-1, 2):
+            for dc in range(-1, 2):
+                r, c = rows[i] + dr, cols[i] + dc
+                inside = (dr or dc) and 0 <= r < height and 0 <= c < width
+                if inside and belief[r, c] == UNKNOWN and stamp[r, c] != k:
+                    stamp[r, c] = k
+                    out[k] += 1
 
 
 @compiled

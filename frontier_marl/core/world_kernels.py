@@ -1,5 +1,6 @@
 """The compiled loops of :class:`~frontier_marl.core.worlds.Worlds` over a batch of worlds: the
-walk of every robot, the end of a recluster, the slots of every robot, the known-cell counts.
+walk of every robot, the start and end of a recluster, the slots of every robot, the explored
+fractions.
 Each calls the one implementation of its operation for world after world."""
 
 from __future__ import annotations
@@ -7,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
+from frontier_marl.core.frontiers import cluster_worlds, count_unknown_around, fill_frontier_masks
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slot_kernels import fill_robot_slots
@@ -61,20 +63,61 @@ def walk_worlds(
 
 
 @compiled
-def settle_clusters(
+def stale_masks(
+    version: np.ndarray,
+    clustered_version: np.ndarray,
+    belief: np.ndarray,
     stale: np.ndarray,
+    masks: np.ndarray,
+) -> int:
+    """The start of a recluster: the worlds whose belief ``version`` is not the one they were
+    clustered at go into ``stale`` (their count is returned), their frontier masks into the
+    first planes of ``masks`` (:func:`~frontier_marl.core.frontiers.fill_frontier_masks`)."""
+    count = 0
+    for n in range(len(version)):
+        if clustered_version[n] != version[n]:
+            stale[count] = n
+            count += 1
+    fill_frontier_masks(belief, stale[:count], masks)
+    return count
+
+
+@compiled
+def recluster(
+    labels: np.ndarray,
+    stale: np.ndarray,
+    max_cells: int,
     by_size: bool,
+    belief: np.ndarray,
+    cell_rows: np.ndarray,
+    cell_cols: np.ndarray,
+    cell_cluster: np.ndarray,
+    n_cells: np.ndarray,
     sizes: np.ndarray,
+    centroids: np.ndarray,
+    gains: np.ndarray,
     n_clusters: np.ndarray,
     version: np.ndarray,
-    gains: np.ndarray,
     clustered_version: np.ndarray,
 ) -> None:
-    """The end of a recluster of the ``stale`` worlds: their clusters' gains are their sizes
-    (``by_size``; otherwise they are set already) and they are clustered as of ``version``."""
+    """The end of a recluster of the ``stale`` worlds, from their ``labels``: their clusters
+    (:func:`~frontier_marl.core.frontiers.cluster_worlds`), the clusters' gains (their sizes
+    ``by_size``, else the unknown cells around them), and clustered as of ``version``."""
+    cluster_worlds(
+        labels, stale, max_cells, cell_rows, cell_cols, cell_cluster, n_cells, sizes, centroids,
+        n_clusters,
+    )  # fmt: skip
     for n in stale:
+        count, cells = n_clusters[n], n_cells[n]
         if by_size:
-            gains[n, : n_clusters[n]] = sizes[n, : n_clusters[n]]
+            gains[n, :count] = sizes[n, :count]
+        else:
+            around = np.zeros(count, dtype=np.int64)
+            count_unknown_around(
+                belief[n], cell_rows[n, :cells], cell_cols[n, :cells], cell_cluster[n, :cells],
+                around,
+            )  # fmt: skip
+            gains[n, :count] = around
         clustered_version[n] = version[n]
 
 
@@ -141,30 +184,55 @@ def all_slots(
             )  # fmt: skip
 
 
-@compiled
-def count_known(belief: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Per world, the known cells of ``belief`` inside the bool mask ``region``."""
-    out = np.zeros(belief.shape[0], dtype=np.int64)
-    for n in range(belief.shape[0]):
-        count = 0
-        for r in range(belief.shape[1]):
-            for c in range(belief.shape[2]):
-                if region[n, r, c] and belief[n, r, c] != UNKNOWN:
-                    count += 1
-        out[n] = count
-    return out
+#: The bases of the explored fraction, by their code in the kernels below: the fraction of
+#: ``all`` cells known, of the true-``free`` cells known free, of the ``reachable`` region known.
+EXPLORED_BASES = ("all", "free", "reachable")
+
+
+def basis_code(basis: str) -> int:
+    """The kernels' code of an explored-fraction ``basis`` (:data:`EXPLORED_BASES`)."""
+    if basis not in EXPLORED_BASES:
+        raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
+    return EXPLORED_BASES.index(basis)
 
 
 @compiled
-def count_states(belief: np.ndarray, free_only: bool) -> np.ndarray:
-    """Per world, the known cells of ``belief`` (the free ones only with ``free_only``)."""
-    out = np.zeros(belief.shape[0], dtype=np.int64)
+def count_cells(basis: int, belief: np.ndarray, region: np.ndarray) -> int:
+    """The cells of one world's ``belief`` that count as explored on ``basis`` (a code of
+    :data:`EXPLORED_BASES`): known, known free, or known inside the bool mask ``region``."""
+    count = 0
+    for r in range(belief.shape[0]):
+        for c in range(belief.shape[1]):
+            state = belief[r, c]
+            if basis == 0:
+                count += state != UNKNOWN
+            elif basis == 1:
+                count += state == FREE
+            else:
+                count += region[r, c] and state != UNKNOWN
+    return count
+
+
+@compiled
+def explored_fractions(
+    basis: int,
+    belief: np.ndarray,
+    true_free: np.ndarray,
+    region: np.ndarray,
+    region_size: np.ndarray,
+    version: np.ndarray,
+    counted_version: np.ndarray,
+    fraction: np.ndarray,
+) -> None:
+    """Per world whose belief ``version`` is not its ``counted_version``, its explored
+    fraction on ``basis`` (:func:`count_cells` over all cells, the true free cells or the
+    reachable ``region``'s ``region_size``) into ``fraction`` (N,); both updated in place."""
     for n in range(belief.shape[0]):
-        count = 0
-        for r in range(belief.shape[1]):
-            for c in range(belief.shape[2]):
-                state = belief[n, r, c]
-                if state == FREE if free_only else state != UNKNOWN:
-                    count += 1
-        out[n] = count
-    return out
+        if counted_version[n] == version[n]:
+            continue
+        count = count_cells(basis, belief[n], region[n])
+        if basis == 0:
+            fraction[n] = count / belief[n].size
+        else:
+            fraction[n] = count / max(true_free[n] if basis == 1 else region_size[n], 1)
+        counted_version[n] = version[n]

@@ -19,13 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from frontier_marl.core.frontiers import (
-    Clusters,
-    cluster_worlds,
-    fill_frontier_masks,
-    label_tiled,
-    unknown_around,
-)
+from frontier_marl.core.frontiers import Clusters, label_tiled
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.planning import path_search_scratch
@@ -33,9 +27,10 @@ from frontier_marl.core.sensing import Sensor, reveal
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays
 from frontier_marl.core.world_kernels import (
     all_slots,
-    count_known,
-    count_states,
-    settle_clusters,
+    basis_code,
+    explored_fractions,
+    recluster,
+    stale_masks,
     walk_worlds,
 )
 
@@ -95,10 +90,13 @@ class Worlds:
         self.gains = np.zeros((n, cells))
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
-        # a recluster's buffers, one blank row below each world (see label_tiled)
-        self._masks = np.zeros((n, height + 1, width), dtype=bool)
-        self._labels = np.zeros((n, height + 1, width), dtype=np.int32)
-        self._fractions: dict[str, tuple[bytes, np.ndarray]] = {}
+        # a recluster's buffers: the stale worlds, their masks and labels, one blank row below
+        # each world (see label_tiled)
+        self.stale = np.zeros(n, dtype=np.int64)
+        self.masks = np.zeros((n, height + 1, width), dtype=bool)
+        self.labels = np.zeros((n, height + 1, width), dtype=np.int32)
+        # per basis code: the explored fractions and the belief versions they were counted at
+        self._fractions = {code: (np.zeros(n), np.full(n, -1, dtype=np.int64)) for code in range(3)}
 
     # ----------------------------------------------------------------- episodes
     def place(
@@ -175,38 +173,34 @@ class Worlds:
     # ----------------------------------------------------------------- frontier view
     def refresh_clusters(self) -> None:
         """Recluster the worlds whose belief changed since they were last clustered."""
-        if self.clustered_version.tobytes() == self.version.tobytes():  # the common case, fast
-            return
-        stale = np.flatnonzero(self.clustered_version != self.version)
-        masks, labels = self._masks[: len(stale)], self._labels[: len(stale)]
-        fill_frontier_masks(self.belief, stale, masks)
-        label_tiled(masks, self.params.connectivity, labels)
-        cluster_worlds(
-            labels,
-            stale,
-            self.params.max_cluster_cells,
-            self.cell_rows,
-            self.cell_cols,
-            self.cell_cluster,
-            self.n_cells,
-            self.sizes,
-            self.centroids,
-            self.n_clusters,
+        stale = stale_masks(
+            self.version, self.clustered_version, self.belief, self.stale, self.masks
         )
-        by_size = self.params.gain != "unknown"
-        if not by_size:
-            for world in stale.tolist():
-                count = int(self.n_clusters[world])
-                self.gains[world, :count] = unknown_around(self.belief[world], self.clusters(world))
-        settle_clusters(
-            stale,
-            by_size,
-            self.sizes,
-            self.n_clusters,
-            self.version,
-            self.gains,
-            self.clustered_version,
-        )
+        if stale:
+            self.label_stale(stale)
+            recluster(
+                self.labels[:stale], self.stale[:stale], self.params.max_cluster_cells,
+                self.params.gain != "unknown", self.belief, self.cell_rows, self.cell_cols,
+                self.cell_cluster, self.n_cells, self.sizes, self.centroids, self.gains,
+                self.n_clusters, self.version, self.clustered_version,
+            )  # fmt: skip
+
+    def label_stale(self, count: int) -> None:
+        """Label the frontier masks of the first ``count`` worlds of ``stale`` (one
+        ``scipy.ndimage.label`` call, :func:`~frontier_marl.core.frontiers.label_tiled`)."""
+        label_tiled(self.masks[:count], self.params.connectivity, self.labels[:count])
+
+    def walk_arrays(self) -> tuple:
+        """The reachable region and its size, then the settings and arrays of the walk
+        (``walk_worlds``' arguments after ``active``, ``search`` last), as one tuple for the
+        rollouts' compiled loops."""
+        offsets, between = self.params.sensor.rays
+        return (
+            self.start_region, self.start_region_size, self.true, self.belief, self.seen,
+            self.positions, self.travelled, self.goals, self.plan_cells, self.plan_meta,
+            self.version, self.params.cells_per_step, offsets, between, self.new_cells,
+            self.walked, self.walked_len, self.reached, self.search,
+        )  # fmt: skip
 
     def clusters(self, world: int) -> Clusters:
         """World ``world``'s clusters as of its last :meth:`refresh_clusters`."""
@@ -261,26 +255,15 @@ class Worlds:
 
     def explored_fraction(self, basis: str) -> np.ndarray:
         """Per world: the fraction of ``all`` cells known, of true-``free`` cells known free, or
-        of the ``reachable`` free region known (kept until a belief changes; read-only)."""
-        key = self.version.tobytes()  # the versions as they were when it was computed
-        cached = self._fractions.get(basis)
-        if cached is not None and cached[0] == key:
-            return cached[1]
-        fraction = self._explored_fraction(basis)
-        fraction.setflags(write=False)
-        self._fractions[basis] = (key, fraction)
-        return fraction
-
-    def _explored_fraction(self, basis: str) -> np.ndarray:
-        belief = self.belief
-        if basis == "all":
-            return count_states(belief, False) / belief[0].size
-        if basis == "free":
-            return count_states(belief, True) / np.maximum(self.true_free, 1)
-        if basis == "reachable":
-            known = count_known(belief, self.start_region)
-            return known / np.maximum(self.start_region_size, 1)
-        raise ValueError(f"threshold_basis must be 'all', 'free' or 'reachable', got {basis!r}")
+        of the ``reachable`` free region known (a copy; worlds whose belief did not change since
+        the last call are not recounted)."""
+        code = basis_code(basis)
+        fraction, counted = self._fractions[code]
+        explored_fractions(
+            code, self.belief, self.true_free, self.start_region, self.start_region_size,
+            self.version, counted, fraction,
+        )  # fmt: skip
+        return fraction.copy()
 
 
 def reachable_region(true_grid: np.ndarray, starts: np.ndarray) -> np.ndarray:

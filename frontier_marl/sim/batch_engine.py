@@ -5,7 +5,9 @@
 one compiled call walks every robot, the frontier masks of all worlds whose belief changed are
 labelled by one ``scipy.ndimage.label`` call, one compiled call builds every robot's slots, one
 applies the reward table and the episode ends, and the observation encoder runs on whole
-arrays. World ``i`` draws its episodes from its own ``numpy.random.Generator``. The vector env
+arrays. A step is two compiled calls on either side of the labelling
+(:mod:`frontier_marl.sim.step_kernels`). World ``i`` draws its episodes from its own
+``numpy.random.Generator``. The vector env
 and the SB3 batched adapter use it directly; the single env's
 :class:`~frontier_marl.sim.engine.ExplorationMDP` is a batch of one.
 """
@@ -18,12 +20,13 @@ import numpy as np
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.core.slots import SLOT_COLUMNS, SlotArrays, commit_to_previous
+from frontier_marl.core.world_kernels import basis_code
 from frontier_marl.core.worlds import Worlds
-from frontier_marl.sim.decisions import count_progress, decide, finish_step
 from frontier_marl.sim.episodes import EpisodeSource, world_params
 from frontier_marl.sim.motion import MotionTrail
 from frontier_marl.sim.observations import ObservationEncoder, observed_heading, teammate_rows
 from frontier_marl.sim.rewards import BatchOutcome, OscillationHistory, table_constants
+from frontier_marl.sim.step_kernels import after_labelling, before_labelling
 
 Observations = np.ndarray | dict[str, np.ndarray]
 _EVERY = slice(None)
@@ -59,6 +62,8 @@ class BatchMDP:
         self.steps_without_progress = np.zeros(n, dtype=np.int64)
         self.done = np.ones(n, dtype=bool)
         self.explored = self.worlds.explored_fraction(cfg.reward.threshold_basis)  # (N,), read-only
+        # the explored fractions as a step counts them, and the belief versions counted at
+        self._fractions, self._counted = np.zeros(n), np.full(n, -1, dtype=np.int64)
         self.targets = np.full((n, k, 2), -1, dtype=np.int64)
         self.heading = np.full((n, k, 2), -1, dtype=np.int64)  # current targets, -1: none
         self.padding = np.zeros((n, k), dtype=bool)
@@ -68,8 +73,6 @@ class BatchMDP:
         self._ends = self.outcome = BatchOutcome(
             np.zeros((n, k)), np.zeros(n, bool), np.zeros(n, bool), np.zeros(n, np.int64)
         )
-        self._all = np.arange(n)
-        self._make_views()
         # the step's own buffers: the chosen targets, padding and oscillation flags, and the
         # cells walked before it
         chosen_flags = (np.empty((n, k), dtype=bool), np.empty((n, k), dtype=bool))
@@ -77,16 +80,45 @@ class BatchMDP:
         self._before = np.empty((n, k), dtype=np.int64)
         self._travel = cfg.reward.kind == "travel"  # the only reward that reads the cells walked
         self._kept = (self.targets, self.heading, self.padding, self.oscillation)  # see settle
+        self._make_views()
 
     def _make_views(self) -> None:
-        """Every robot's slots, position and heading as ``(N K, ...)`` views, made once (and
-        again after a copy: a copied view would no longer see its array)."""
+        """Every robot's slots, position and heading as ``(N K, ...)`` views, and the
+        arguments of the step's compiled calls, made once (and again after a copy: a copied
+        view would no longer see its array)."""
         self._every_row = self.slots.rows(_EVERY)
         self._positions = self.worlds.positions.reshape(-1, 2)
         self._heading = self.heading.reshape(-1, 2)
+        cfg, w, slots = self.cfg, self.worlds, self.slots
+        travel = (self._travel, self._before, self.steps, self.steps_without_progress)
+        chosen = self._chosen
+        offsets, between = w.params.sensor.rays
+        self._before_args = (
+            slots.live, slots.target, self._oscillation.history, *chosen, *travel,
+            w.true, w.belief, w.seen, w.positions, w.travelled, w.goals, w.plan_cells,
+            w.plan_meta, w.version, w.params.cells_per_step, offsets, between, w.new_cells,
+            w.walked, w.walked_len, w.reached, *w.search,
+            w.clustered_version, w.stale, w.masks,
+        )  # fmt: skip
+        constants, _, padding_truncates, no_progress_limit, max_steps = table_constants(cfg.reward)
+        self._after_args = (
+            slots.live, *chosen, *travel,
+            w.start_region, w.start_region_size, w.true_free, w.belief, w.positions, w.travelled,
+            w.version, w.reached,
+            w.labels, w.stale, w.params.max_cluster_cells, w.params.gain != "unknown",
+            w.cell_rows, w.cell_cols, w.cell_cluster, w.n_cells, w.sizes, w.centroids, w.gains,
+            w.n_clusters, w.clustered_version,
+            cfg.observation.sort_by_distance, slots.cluster, slots.valid, slots.centroid,
+            slots.target, slots.distance, slots.size, slots.gain, slots.path_length, slots.mask,
+            self.packed,
+            basis_code(cfg.reward.threshold_basis), self._counted, self._fractions,
+            constants, padding_truncates, no_progress_limit, max_steps,
+            cfg.reward.explore_threshold, self._ends.terminated, self._ends.truncated,
+            self._ends.reason, self.done, *self._kept,
+        )  # fmt: skip
 
     def __getstate__(self) -> dict[str, Any]:
-        views = ("_every_row", "_positions", "_heading")
+        views = ("_every_row", "_positions", "_heading", "_before_args", "_after_args")
         return {k: v for k, v in self.__dict__.items() if k not in views}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -119,41 +151,28 @@ class BatchMDP:
         holds valid slot indices (checked by the caller). Inactive worlds (ended, or waiting
         while others play forced steps) keep their state: they do not move and get no reward
         or end flag."""
-        slots, worlds = self.slots, self.worlds
-        targets, padding, oscillation = self._chosen
-        decide(
-            slots.live, slots.target, np.asarray(actions, dtype=np.int64), active,
-            self._oscillation.history, targets, padding, oscillation,
-        )  # fmt: skip
-        if self._travel:
-            np.copyto(self._before, worlds.travelled)
         if self._trail is not None:
-            self._trail.push(worlds.positions, active)
-        worlds.move(targets, active)
+            self._trail.push(self.worlds.positions, active)
+        actions = np.asarray(actions, dtype=np.int64)
         new_cells = np.empty_like(self.new_cells)  # fresh: the last step's stay readable
-        count_progress(active, worlds.new_cells, new_cells, self.steps, self.steps_without_progress)
-        worlds.slots(slots, self._all[active], self.cfg.observation.sort_by_distance, self.packed)
+        stale = before_labelling(actions, active, new_cells, *self._before_args)
+        if stale:
+            self.worlds.label_stale(stale)
+        ends = self._ends
+        ends.rewards = np.empty_like(ends.rewards)
+        explored = np.empty(self.n_worlds)
+        after_labelling(active, new_cells, stale, explored, ends.rewards, *self._after_args)
         if self.cfg.observation.commit != "none":
+            slots = self.slots
             slots.mask[:] = commit_to_previous(
                 slots.mask,
                 slots.target,
                 slots.valid,
-                targets,
+                self._chosen[0],
                 new_cells > 0,
                 self.cfg.observation.commit,
             )
-        reward = self.cfg.reward
-        fraction = self.explored = worlds.explored_fraction(reward.threshold_basis)
-        ends = self._ends
-        ends.rewards = np.empty_like(ends.rewards)
-        finish_step(
-            *table_constants(reward), fraction, reward.explore_threshold, slots.live, new_cells,
-            self.steps, self.steps_without_progress,
-            worlds.travelled - self._before if self._travel else new_cells, active,
-            targets, worlds.reached, padding, oscillation,
-            (ends.rewards, ends.terminated, ends.truncated, ends.reason), self.done, self._kept,
-        )  # fmt: skip
-        self.new_cells, self.outcome = new_cells, ends
+        self.new_cells, self.outcome, self.explored = new_cells, ends, explored
 
     def play_forced(self) -> None:
         """Step every live world whose robots each have exactly one valid slot (a commitment,

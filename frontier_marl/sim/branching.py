@@ -98,4 +98,5 @@ def clone_mdp(
         batch._trail.cells[rows] = source._trail.cells[index]
     for name in _DECISIONS:
         getattr(batch, name)[rows] = getattr(source, name)[index]
+    batch.explored = batch.worlds.explored_fraction(source.cfg.reward.threshold_basis)
     return batch

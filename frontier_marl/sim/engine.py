@@ -68,6 +68,7 @@ class ExplorationMDP:
         self.last: StepResult | None = None  # the latest step, None right after reset
         self._tables: list[SlotTable] | None = None  # views of the slots, made when asked
         self._agents = range(cfg.n_agents)
+        self._actions = np.zeros((1, cfg.n_agents), dtype=np.int64)  # the step's slot indices
         self._make_views()
 
     def _make_views(self) -> None:
@@ -118,10 +119,9 @@ class ExplorationMDP:
         n = self.cfg.n_agents
         if len(actions) != n:
             raise ValueError(f"expected {n} actions (one per robot), got {len(actions)}")
-        slots = np.array(
-            [[self._check_action(action, agent) for agent, action in enumerate(actions)]],
-            dtype=np.int64,
-        )
+        slots = self._actions
+        for agent, action in enumerate(actions):
+            slots[0, agent] = self._check_action(action, agent)
         batch = self.batch
         batch.step(slots, _ONE)
         self._tables = None

@@ -27,9 +27,9 @@ import numpy as np
 from frontier_marl.core.compiled import compiled
 from frontier_marl.core.frontier_union import update_frontier
 from frontier_marl.core.frontiers import is_frontier
-from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slots import SlotArrays
+from frontier_marl.core.world_kernels import basis_code, count_cells
 from frontier_marl.core.worlds import Worlds
 from frontier_marl.sim.nearest_path import (
     DecisionScratch,
@@ -39,6 +39,7 @@ from frontier_marl.sim.nearest_path import (
 )
 
 ROLLOUT_SLOTS = 256  # the base policy sees every reachable cluster, as the heuristics do
+_REACHABLE = basis_code("reachable")
 
 
 class RolloutBase(Protocol):
@@ -131,19 +132,8 @@ class _RolloutState:
         return self.done, self.pending, self.cost, self.known, self.exact, self.sensed
 
 
-def _world_arrays(sims: Worlds) -> tuple[object, ...]:
-    """The arrays and settings of ``sims`` that :func:`advance_world` reads and writes."""
-    offsets, between = sims.params.sensor.rays
-    return (
-        sims.start_region, sims.start_region_size, sims.true, sims.belief, sims.seen,
-        sims.positions, sims.travelled, sims.goals, sims.plan_cells, sims.plan_meta,
-        sims.version, sims.params.cells_per_step, offsets, between, sims.new_cells,
-        sims.walked, sims.walked_len, sims.reached, sims.search,
-    )  # fmt: skip
-
-
 def _advance(sims: Worlds, state: _RolloutState, start: int, coverage: float, cap: int) -> None:
-    advance(state.arrays(), _world_arrays(sims), start, coverage, cap, state.deciding)
+    advance(state.arrays(), sims.walk_arrays(), start, coverage, cap, state.deciding)
 
 
 def _cap(state: _RolloutState, max_cells: int) -> int:
@@ -165,7 +155,7 @@ def _rollout_nearest_path(
     scratch = DecisionScratch(sims.shape)
     reach = int(np.abs(params.sensor.rays[0]).max(initial=0))  # a sensed cell's farthest change
     rollout_nearest_path(
-        state.arrays(), _world_arrays(sims), start, coverage, cap, params.connectivity,
+        state.arrays(), sims.walk_arrays(), start, coverage, cap, params.connectivity,
         params.max_cluster_cells, n_slots, reach, scratch.arrays(), prune,
     )  # fmt: skip
 
@@ -189,7 +179,7 @@ def advance_world(
     """Walk live world ``n`` (a ``pending`` one first toward its new goal) until it ends
     (coverage reached: ``cost`` is its walk; ``max_cells`` walked; ``done`` set) or its goal is
     no longer a frontier cell or is reached (returns True: it needs a decision). ``state``:
-    :meth:`_RolloutState.arrays`; ``world``: :func:`_world_arrays`."""
+    :meth:`_RolloutState.arrays`; ``world``: :meth:`Worlds.walk_arrays`."""
     done, pending, cost, known, exact, sensed = state
     (
         region, region_size, true, belief, seen, positions, travelled, goals, plan_cells,
@@ -213,7 +203,7 @@ def advance_world(
         moving = True
         size = max(region_size[n], 1)
         if not exact[n] and known[n] / size >= coverage:  # the bound says maybe: count
-            known[n] = _count_known(belief[n], region[n])
+            known[n] = count_cells(_REACHABLE, belief[n], region[n])
             exact[n] = True
         covered = known[n] / size >= coverage
         walked_cells = travelled[n, 0] - start
@@ -291,13 +281,3 @@ def _add_sensed(box: np.ndarray, walked: np.ndarray, walked_len: np.ndarray) -> 
             else:
                 box[0], box[1] = min(box[0], r), max(box[1], r)
                 box[2], box[3] = min(box[2], c), max(box[3], c)
-
-
-@compiled
-def _count_known(belief: np.ndarray, region: np.ndarray) -> int:
-    count = 0
-    for r in range(belief.shape[0]):
-        for c in range(belief.shape[1]):
-            if region[r, c] and belief[r, c] != UNKNOWN:
-                count += 1
-    return count

@@ -9,9 +9,11 @@ checkpoints, the SuperSuit pipeline: ``train.vec_env=supersuit``; the batched en
 benchmark, ``bench_vector_env.py``) and times, inside it, the env (the FrontierParallelEnv step
 itself), the SuperSuit and SB3 vector layers above it, and the DQN gradient steps; the rest is
 SB3's collection loop (action selection, replay buffer, logging). ``--stages`` also times the
-parts of a decision step (movement and sensing, frontier clustering and ``scipy.ndimage.label``,
-slots, observation, reward table, info) and the episode resets. Wall and CPU times are both
-reported: on a shared machine the CPU time is the steadier number. Run one benchmark at a time."""
+parts of a decision step (the compiled call before the labelling: decisions, movement and
+sensing, frontier masks; ``scipy.ndimage.label``; the compiled call after it: clusters, slots,
+explored fraction, reward table; the observations; the info dicts) and the episode resets.
+Wall and CPU times are both reported: on a shared machine the CPU time is the steadier number.
+Run one benchmark at a time."""
 
 from __future__ import annotations
 
@@ -27,7 +29,6 @@ from pathlib import Path
 from typing import Any
 
 import stable_baselines3
-from scipy import ndimage
 from stable_baselines3 import DQN
 
 from frontier_marl.core import worlds
@@ -66,11 +67,10 @@ class Timer:
 def stage_functions() -> list[tuple[object, str]]:
     """(owner, attribute) of the functions ``--stages`` times; the first two cover the rest."""
     return [
-        (worlds.Worlds, "move"),  # planning, walking, sensing
-        (worlds.Worlds, "slots"),  # clusters (with ndimage.label) and slots
-        (ndimage, "label"),
+        (batch_engine, "before_labelling"),  # decisions, planning, walking, sensing, masks
+        (worlds.Worlds, "label_stale"),  # the frontier masks labelled (ndimage.label)
+        (batch_engine, "after_labelling"),  # clusters, slots, explored fraction, reward table
         (batch_engine.BatchMDP, "observations"),
-        (batch_engine, "finish_step"),  # the reward table and the end of the step
         (parallel, "build_infos"),  # the info dicts
         (engine.ExplorationMDP, "reset"),
     ]
@@ -129,7 +129,7 @@ def _timed(stages: bool) -> Iterator[_Timers]:
     patched: list[tuple[object, str, object]] = []
     if stages:
         for owner, name in stage_functions():
-            timer = timers.stages[name if owner is not ndimage else "ndimage.label"] = Timer()
+            timer = timers.stages[name] = Timer()
             original = getattr(owner, name)
             patched.append((owner, name, original))
             setattr(owner, name, timer.wrap(original))
