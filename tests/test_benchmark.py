@@ -317,6 +317,15 @@ def test_cli_bad_input(argv, message, capsys):
     assert message in capsys.readouterr().err
 
 
+def test_a_map_folder_without_maps_names_its_subfolders_that_have_some(tmp_path, capsys):
+    (tmp_path / "plans").mkdir()
+    (tmp_path / "plans" / "a.txt").write_text("..\n..\n")
+    (tmp_path / "empty").mkdir()
+    assert main(["benchmark", "--no-progress", "--map", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "holds no .pgm, .png or .txt map (its subfolders plans do: pass one of them)" in err
+
+
 def test_run_on_seeds_refuses_held_out_seeds():
     with pytest.raises(ValueError, match="held-out seeds overlap"):
         bench.run_on_seeds(["nearest-path"], range(899_999, 900_001), 1)

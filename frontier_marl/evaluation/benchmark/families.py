@@ -144,7 +144,7 @@ def map_files(paths: Sequence[str | Path]) -> list[str]:
         if path.is_dir():
             found = sorted(p for p in path.iterdir() if p.suffix.lower() in MAP_SUFFIXES)
             if not found:
-                raise ValueError(f"map folder {path} holds no .pgm, .png or .txt map")
+                raise ValueError(f"map folder {path} holds no .pgm, .png or .txt map{_hint(path)}")
             files += [str(p) for p in found]
         elif path.is_file():
             files.append(str(path))
@@ -153,6 +153,16 @@ def map_files(paths: Sequence[str | Path]) -> list[str]:
     if not files:
         raise ValueError("no map file given")
     return files
+
+
+def _hint(folder: Path) -> str:
+    """Which subfolders of ``folder`` hold maps (a folder is not searched recursively)."""
+    holding = sorted(
+        sub.name
+        for sub in folder.iterdir()
+        if sub.is_dir() and any(p.suffix.lower() in MAP_SUFFIXES for p in sub.iterdir())
+    )
+    return f" (its subfolders {', '.join(holding)} do: pass one of them)" if holding else ""
 
 
 def loaded_map_range(height: int, width: int) -> int:
