@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import torch
 
+import frontier_marl
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.world import World, WorldParams
 from frontier_marl.policies.lookahead import LookaheadOracle, lookahead_costs
@@ -171,3 +172,37 @@ def test_the_headroom_probe_scores_both_oracles_in_frontier_rules_env(tmp_path: 
     assert [row["policy"] for row in rows] == ["frontier-rule", "oracle-np-12", "oracle-rule-12"]
     assert {row["config"]["n_slots"] for row in rows} == {12}  # the same slots for all three
     assert all(row["success"] == 1 for row in rows)
+
+
+def test_completion_costs_keep_the_known_cells_and_average_the_maps() -> None:
+    from frontier_marl.experiments.explorer_studies.completions import completion_costs
+
+    world = _corridor()
+    targets = np.array([[1, 3], [1, 5]])
+    true_grid = world.true_grid.copy()
+    # the true map as its own completion: the true-map lookahead's costs
+    assert completion_costs(world.batch, 0, targets, 0.99, 100, [true_grid]).tolist() == [14, 20]
+    # walls wherever the robot knows nothing: the known cells are the whole region, covered
+    # already, so no candidate costs a cell
+    walls = np.ones_like(true_grid)
+    assert completion_costs(world.batch, 0, targets, 0.99, 100, [walls]).tolist() == [0, 0]
+    both = completion_costs(world.batch, 0, targets, 0.99, 100, [true_grid, walls])
+    assert both.tolist() == [7, 10]
+    assert world.travelled.tolist() == [0]  # simulations on copies
+
+
+def test_the_completions_study_plays_its_planner_on_validation_episodes(tmp_path: Path) -> None:
+    from frontier_marl.experiments.explorer_studies import completions
+
+    out = tmp_path / "completions.json"
+    argv = ["--families", "random-20", "--samples", "2", "--episodes", "1", "--no-oracle"]
+    assert completions.main([*argv, "--jobs", "1", "--no-progress", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["policy"] for row in rows] == ["frontier-rule", "completions-2"]
+    assert all(row["seeds"] == [800_000] and row["success"] == 1 for row in rows)
+    with pytest.raises(SystemExit):
+        completions.main(["--samples", "0"])
+    planner = completions.CompletionLookahead(2)
+    env = frontier_marl.FrontierParallelEnv(preset="thesis-20x20", map_mode="static")
+    with pytest.raises(ValueError, match="dynamic generated maps"):
+        planner.attach(env)

@@ -1,0 +1,164 @@
+"""How much of the true-map oracle's gain does the belief hold? A lookahead on sampled maps.
+
+The true-map oracle (``oracle-np-12``, :mod:`.headroom`) knows the unknown. This study's
+planner does not: at each decision it draws ``K`` maps from the family's own generator, keeps
+every cell the robot knows (so each draw is a completion of the belief, though not one drawn
+from the exact posterior: outside the known cells the draw ignores them), simulates each of
+frontier-rule's valid slots on every completion with nearest-path finishing, and takes the
+slot of least mean cost. As K grows this is a one-step Bayesian rollout under a prior of the
+family's maps. If it gains much over frontier-rule, the belief and a prior of the family hold
+the information a learned scorer should extract; if it gains little, the oracle's headroom
+lies mostly in what no belief shows.
+
+    python benchmarks/explorer_completions.py --families random-20,random-30,rooms-32 \\
+        --samples 1,8 --episodes 16
+
+Validation episodes only. It reads the generator of the env's family, so it refuses loaded or
+static maps (a draw would be the true map).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.core.grid import OCCUPIED, UNKNOWN
+from frontier_marl.core.worlds import Worlds, reachable_region
+from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
+from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_benchmark
+from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.base import HeuristicPolicy, Info, first_by, slot_table
+from frontier_marl.policies.lookahead import LookaheadOracle
+from frontier_marl.sim.branching import branch
+from frontier_marl.sim.episodes import EpisodeSource
+from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
+
+
+def completion_costs(
+    source: Worlds,
+    index: int,
+    targets: np.ndarray,
+    coverage: float,
+    max_cells: int,
+    maps: list[np.ndarray],
+) -> np.ndarray:
+    """Per target (M, 2), the mean over ``maps`` (each a grid of the world's shape) of the
+    cells robot 0 of world ``index`` walks until ``coverage`` of its reachable free region is
+    known, if the unknown cells are those of the map (the known cells stay as the belief has
+    them), it walks to the target first and nearest-path finishes."""
+    targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
+    m, samples = len(targets), len(maps)
+    base = NearestPathBase()
+    sims = branch(source, index, m * samples, base.gain)
+    belief = source.belief[index]
+    known = belief != UNKNOWN
+    for k, drawn in enumerate(maps):
+        grid = np.array(drawn, dtype=bool)
+        grid[known] = belief[known] == OCCUPIED
+        region = reachable_region(grid, source.positions[index])
+        rows = slice(k * m, (k + 1) * m)
+        sims.true[rows] = grid
+        sims.start_region[rows] = region
+        sims.start_region_size[rows] = np.count_nonzero(region)
+        sims.true_free[rows] = np.count_nonzero(~grid)
+    sims.goals[:, 0] = np.tile(targets, (samples, 1))
+    start = int(source.travelled[index, 0])
+    costs = rollout_costs(sims, start, coverage, max_cells, base)
+    return costs.reshape(samples, m).mean(axis=0)
+
+
+class CompletionLookahead(HeuristicPolicy):
+    """The live slot of least :func:`completion_costs` over ``samples`` maps drawn from the
+    env's own generator (ties: nearest path, then nearest centroid), kept until reached. The
+    draws of a decision are seeded by the belief and the robot's cell, so an episode plays the
+    same in any process."""
+
+    def __init__(self, samples: int, seed: int = 0) -> None:
+        super().__init__("until-reached")
+        if samples < 1:
+            raise ValueError(f"samples must be >= 1, got {samples}")
+        self.samples = samples
+        self.seed = seed
+        self.name = f"completions-{samples}"
+        self._env: Any = None
+        self._source: EpisodeSource | None = None
+
+    def attach(self, env: Any) -> None:
+        cfg = env.config
+        if cfg.map_path is not None or cfg.map_mode != "dynamic":
+            raise ValueError(
+                f"{self.name} draws maps from the env's generator: it needs dynamic generated "
+                "maps (a loaded or static map would be the true map)"
+            )
+        self._env = env
+        self._source = EpisodeSource(cfg)
+
+    def choose(self, info: Info) -> int:
+        table = slot_table(info)
+        if table.live <= 1:
+            return 0
+        if self._env is None or self._source is None:
+            raise RuntimeError(f"{self.name} needs attach(env) before it acts")
+        world = self._env.world
+        height, width = world.shape
+        digest = hashlib.blake2b(world.belief.tobytes() + world.positions.tobytes())
+        rng = np.random.default_rng([self.seed, int.from_bytes(digest.digest()[:8], "little")])
+        maps = [self._source.true_grid(rng) for _ in range(self.samples)]
+        live = table.live
+        costs = completion_costs(
+            world.batch, world.index, table.target[:live],
+            self._env.config.reward.explore_threshold, 4 * height * width, maps,
+        )  # fmt: skip
+        return first_by(costs, table.path_length[:live], table.distance[:live])
+
+
+def contenders(samples: list[int], oracle: bool) -> list[Contender]:
+    """frontier-rule, the sampled lookahead for each K of ``samples`` and (``oracle``) the
+    true-map oracle, all in frontier-rule's env."""
+    rule = heuristic("frontier-rule")
+    out = [rule]
+    for k in samples:
+        out.append(
+            Contender(f"completions-{k}", False, partial(CompletionLookahead, k), rule.config)
+        )
+    if oracle:
+        out.append(Contender("oracle-np-12", False, LookaheadOracle, rule.config))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--families", default="random-20,random-30,rooms-32")
+    parser.add_argument("--samples", default="1,8", help="comma-separated K: maps per decision")
+    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
+    parser.add_argument("--no-oracle", action="store_true", help="leave the true-map oracle out")
+    parser.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    names = args.families.split(",")
+    try:
+        check_families(names, "--families")
+        samples = [int(k) for k in args.samples.split(",")]
+    except ValueError as exc:
+        parser.error(f"{exc} (families: {', '.join(FAMILIES)}; samples: integers >= 1)")
+    if min(samples) < 1:
+        parser.error(f"--samples must be integers >= 1, got {args.samples}")
+    rows = run_benchmark(
+        [family(name) for name in names],
+        contenders(samples, not args.no_oracle),
+        args.episodes,
+        progress=not args.no_progress,
+        split="validation",
+        jobs=args.jobs,
+    )
+    print(format_table(rows))
+    if args.json is not None:
+        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
+    return 0
