@@ -7,11 +7,14 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import ndimage
 
 import frontier_marl
 from frontier_marl import FrontierExploreEnv, reason_name, slot_table
 from frontier_marl.core.grid import FREE, UNKNOWN
+from frontier_marl.core.slots import SlotArrays
 
 INFO_KEYS = {
     "explored_fraction",
@@ -412,6 +415,48 @@ def test_cluster_features_encode_the_slot_table(centroid: str, normalize: bool) 
             break
         obs, _, _, _, infos = env.step(_random_actions(env, infos, rng))
     assert padding_seen
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    centroid=st.sampled_from(["none", *ENCODINGS]),
+    info_gain=st.booleans(),
+    normalize=st.booleans(),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_compiled_features_are_numpys_to_the_bit(centroid, info_gain, normalize, seed) -> None:
+    """The thesis layout's vectors equal the numpy formula: float64 values divided by their
+    scale, then rounded to float32 (relative offsets zero in padding slots)."""
+    from frontier_marl.config import make_config
+    from frontier_marl.sim.observations import ObservationEncoder
+
+    info_gain = info_gain or centroid == "none"  # an empty layout is refused
+    cfg = make_config(
+        "thesis-20x20", centroid=centroid, info_gain=info_gain, normalize=normalize, n_slots=4
+    )
+    encoder = ObservationEncoder(cfg)
+    rng = np.random.default_rng(seed)
+    slots = SlotArrays.empty(3, 1, 4).rows(slice(None))
+    slots.valid[:] = rng.random((3, 4)) < 0.7
+    slots.centroid[:] = rng.random((3, 4, 2)) * 20 * slots.valid[..., None]
+    slots.distance[:] = rng.random((3, 4)) * 28 * slots.valid
+    slots.gain[:] = rng.integers(0, 30, (3, 4)) * slots.valid
+    positions = rng.integers(0, 20, (3, 2))
+    parts = []
+    if centroid == "absolute":
+        parts.append(slots.centroid)
+    elif centroid == "relative":
+        relative = slots.centroid - positions[:, None, :]
+        parts.append(np.where(slots.valid[..., None], relative, 0.0))
+    elif centroid == "distance":
+        parts.append(slots.distance[..., None])
+    if info_gain:
+        parts.append(slots.gain[..., None])
+    expected = np.concatenate(parts, axis=-1) / encoder._scale
+    observed = encoder.encode_batch(slots, positions)
+    flat = observed["clusters"] if isinstance(observed, dict) else observed
+    assert flat.dtype == np.float32
+    assert np.array_equal(flat, expected.astype(np.float32).reshape(3, -1))
 
 
 def test_relative_encoding_flat_box() -> None:

@@ -26,6 +26,7 @@ import numpy as np
 from gymnasium import spaces
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.core.compiled import compiled
 from frontier_marl.core.slots import SlotArrays, SlotTable
 from frontier_marl.sim.features import (
     cluster_fill,
@@ -39,6 +40,9 @@ from frontier_marl.sim.features import (
     turn_costs,
     unknown_near,
 )
+
+#: The centroid encodings' codes in :func:`thesis_features`.
+_CENTROID_CODES = {"none": 0, "absolute": 1, "relative": 2, "distance": 3}
 
 
 class ObservationEncoder:
@@ -181,25 +185,12 @@ class ObservationEncoder:
                 parts.append(team_features(slots, rows))
             features = np.concatenate(parts, axis=-1)  # one copy, not one per feature
             return {"slots": features, "action_mask": np.array(slots.mask, dtype=np.int8)}
-        dtype = np.float64 if self.normalize else np.float32  # normalize in float64
         count = len(positions)
-        features = np.zeros((count, self.n_slots, self.features_per_slot), dtype=dtype)
-        column = 0
-        if self.centroid == "absolute":
-            features[..., 0:2] = slots.centroid  # padding slots hold zeros
-            column = 2
-        elif self.centroid == "relative":
-            relative = slots.centroid - positions[:, None, :]
-            features[..., 0:2] = np.where(slots.valid[..., None], relative, 0.0)
-            column = 2
-        elif self.centroid == "distance":
-            features[..., 0] = slots.distance
-            column = 1
-        if self.info_gain:
-            features[..., column] = slots.gain
-        if self.normalize:
-            features = (features / self._scale).astype(np.float32)
-        flat = features.reshape(count, -1)
+        flat = np.empty((count, self.n_slots * self.features_per_slot), dtype=np.float32)
+        thesis_features(
+            _CENTROID_CODES[self.centroid], self.info_gain, slots.centroid, slots.valid,
+            slots.distance, slots.gain, positions, self._scale, flat,
+        )  # fmt: skip
         if not self.is_dict:
             return flat
         out: dict[str, np.ndarray] = {"clusters": flat}
@@ -217,6 +208,45 @@ class ObservationEncoder:
             scale = np.tile(self._position_scale, teammates.shape[1] // 2)
             out["teammates"] = (teammates / scale).astype(np.float32)
         return out
+
+
+@compiled
+def thesis_features(
+    centroid_code: int,
+    info_gain: bool,
+    centroid: np.ndarray,
+    valid: np.ndarray,
+    distance: np.ndarray,
+    gain: np.ndarray,
+    positions: np.ndarray,
+    scale: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """The thesis layout's ``clusters`` vectors of M robots into ``out`` (float32 (M, S F)):
+    per slot the centroid encoding (``centroid_code`` of :data:`_CENTROID_CODES`; relative
+    offsets are zero in padding slots), then the gain if ``info_gain``, each value divided by
+    its ``scale`` (F,) in float64 and then rounded to float32, as numpy would."""
+    features = len(scale)
+    for m in range(out.shape[0]):
+        for slot in range(centroid.shape[1]):
+            column = slot * features
+            if centroid_code == 1:
+                out[m, column] = centroid[m, slot, 0] / scale[0]
+                out[m, column + 1] = centroid[m, slot, 1] / scale[1]
+                column += 2
+            elif centroid_code == 2:
+                if valid[m, slot]:
+                    out[m, column] = (centroid[m, slot, 0] - positions[m, 0]) / scale[0]
+                    out[m, column + 1] = (centroid[m, slot, 1] - positions[m, 1]) / scale[1]
+                else:
+                    out[m, column] = 0.0
+                    out[m, column + 1] = 0.0
+                column += 2
+            elif centroid_code == 3:
+                out[m, column] = distance[m, slot] / scale[0]
+                column += 1
+            if info_gain:
+                out[m, column] = gain[m, slot] / scale[features - 1]
 
 
 def observed_heading(heading: np.ndarray, features: str) -> np.ndarray:
