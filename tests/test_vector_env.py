@@ -275,7 +275,13 @@ def test_num_envs_of_another_type_is_refused(num_envs: Any) -> None:
 
 def test_bad_actions_are_refused_by_name() -> None:
     vec = vector_env(2, n_agents=2)
+    with pytest.raises(RuntimeError, match="before reset"):
+        vec.step(np.zeros(4, dtype=np.int64))
     vec.reset(seed=0)
+    with pytest.raises(ValueError, match=r"actions\[1\] = 18446744073709551615"):
+        vec.step(np.array([0, 2**64 - 1, 0, 0], dtype=np.uint64))  # -1 as an int64
+    with pytest.raises(ValueError, match=r"actions\[3\] = -7"):
+        vec.step(np.array([0, 0, 0, -7], dtype=np.int32))
     with pytest.raises(ValueError, match=r"shape \(4,\)"):
         vec.step(np.zeros(2, dtype=np.int64))
     with pytest.raises(TypeError, match="dtype float64"):

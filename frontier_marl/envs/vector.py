@@ -108,6 +108,7 @@ class FrontierVectorEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.render_mode = None
         self._seeded = np.zeros(self.n_worlds, dtype=bool)
+        self._started = False  # reset() was called
         self._valid = np.ones(self.num_envs, dtype=bool)  # the `_key` mask of every info key
 
     # ------------------------------------------------------------------ API
@@ -124,10 +125,11 @@ class FrontierVectorEnv(VectorEnv):
         if isinstance(seed, int):
             self.action_space.seed(seed)
         self.mdp.reset_worlds(np.arange(self.n_worlds))
+        self._started = True
         return self._observations(), self._infos(reset=True)
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        if not self._seeded.all():
+        if not self._started:
             raise RuntimeError("step() called before reset(): call reset() first")
         mdp = self.mdp
         chosen = self._check_actions(actions)
@@ -148,8 +150,8 @@ class FrontierVectorEnv(VectorEnv):
                 observations = self._observations()
         outcome = mdp.outcome
         rewards = outcome.rewards.reshape(-1)
-        terminations = np.repeat(outcome.terminated, self.n_agents)
-        truncations = np.repeat(outcome.truncated, self.n_agents)
+        terminations = self._per_robot(outcome.terminated)
+        truncations = self._per_robot(outcome.truncated)
         infos.update(self._infos(reset=False))
         return observations, rewards, terminations, truncations, infos
 
@@ -187,14 +189,18 @@ class FrontierVectorEnv(VectorEnv):
                 f"{self.n_worlds} x {self.n_agents}), got {array.shape}"
             )
         n_slots = self.config.n_slots
-        bad = (array < 0) | (array >= n_slots)
-        if bad.any():
-            j = int(np.flatnonzero(bad)[0])
+        wide = array.astype(np.int64, copy=False)
+        if (wide.view(np.uint64) >= n_slots).any():  # one test: negatives read as huge
+            j = int(np.flatnonzero((array < 0) | (array >= n_slots))[0])
             raise ValueError(
                 f"actions must be in [0, {n_slots - 1}] (n_slots={n_slots}); "
                 f"actions[{j}] = {array[j]}"
             )
-        return array.astype(np.int64, copy=False).reshape(self.n_worlds, self.n_agents)
+        return wide.reshape(self.n_worlds, self.n_agents)
+
+    def _per_robot(self, flags: np.ndarray) -> np.ndarray:
+        """A per-world array as one entry per robot (a fresh array)."""
+        return flags.copy() if self.n_agents == 1 else np.repeat(flags, self.n_agents)
 
     def _observations(self) -> Any:
         batch = self.mdp.robot_observations()  # (num_envs, ...): robots world after world
