@@ -175,7 +175,7 @@ def test_the_headroom_probe_scores_both_oracles_in_frontier_rules_env(tmp_path: 
 
 
 def test_completion_costs_keep_the_known_cells_and_average_the_maps() -> None:
-    from frontier_marl.experiments.explorer_studies.completions import completion_costs
+    from frontier_marl.policies.lookahead import completion_costs
 
     world = _corridor()
     targets = np.array([[1, 3], [1, 5]])

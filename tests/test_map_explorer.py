@@ -150,8 +150,8 @@ def test_labels_finished_by_frontier_rule_cost_what_its_rollouts_walk() -> None:
     (world,) = map_families.variant_configs(fam, None, 1)
     cfg = scorer_config(world)
     task = ("rooms-32", int(fam.train[0]), None, 8, 0.5, 0)
-    by_rule = cost_regression._label((*task, "frontier-rule"))
-    by_nearest = cost_regression._label((*task, "nearest-path"))
+    by_rule = cost_regression._label((*task, "frontier-rule", 0))
+    by_nearest = cost_regression._label((*task, "nearest-path", 0))
     np.testing.assert_array_equal(by_rule.decision, by_nearest.decision)  # same behaviour
     assert not np.array_equal(by_rule.cost, by_nearest.cost)  # other finishers, other costs
     env = frontier_marl.parallel_env(config=cfg)
@@ -313,6 +313,18 @@ def test_the_explorer_acts_on_valid_slots_only() -> None:
     assert choices > 5  # it chose among several slots, not only forced steps
 
 
+def test_labels_over_map_completions_are_other_costs_of_the_same_decisions() -> None:
+    fam = map_families.family("random-20")
+    task = ("random-20", int(fam.train[0]), None, 8, 0.5, 0, "nearest-path")
+    true_map = cost_regression._label((*task, 0))
+    completed = cost_regression._label((*task, 3))
+    np.testing.assert_array_equal(completed.decision, true_map.decision)  # same behaviour
+    np.testing.assert_array_equal(completed.crops, true_map.crops)
+    assert not np.array_equal(completed.cost, true_map.cost)
+    assert np.array_equal(cost_regression._label((*task, 3)).cost, completed.cost)  # seeded
+    assert (completed.cost > 0).all()
+
+
 def test_a_bad_regression_section_is_named() -> None:
     with pytest.raises(ValueError, match=r"regression.rounds must be an integer >= 1"):
         load_experiment("explorer-map", ["regression.rounds=0"])
@@ -320,5 +332,11 @@ def test_a_bad_regression_section_is_named() -> None:
         load_experiment("explorer-map", ["regression.epochs=3"])
     with pytest.raises(ValueError, match="regression.finisher must be one of nearest-path, "):
         load_experiment("explorer-map", ['regression.finisher="greedy-gain"'])
+    with pytest.raises(ValueError, match="regression.completions must be an integer >= 0"):
+        load_experiment("explorer-map", ["regression.completions=-1"])
+    with pytest.raises(ValueError, match="regression.completions needs regression.finisher"):
+        load_experiment(
+            "explorer-map", ["regression.completions=4", 'regression.finisher="frontier-rule"']
+        )
     with pytest.raises(ValueError, match="needs train.families and one robot"):
         load_experiment("explorer-map", ["train.families=[]"])

@@ -21,15 +21,18 @@ cost-to-go labels with ``regression.finisher = "frontier-rule"``).
 
 from __future__ import annotations
 
+import hashlib
 from typing import Any
 
 import numpy as np
 
 from frontier_marl.config import EnvConfig
+from frontier_marl.core.grid import OCCUPIED, UNKNOWN
 from frontier_marl.core.slots import SlotArrays
-from frontier_marl.core.worlds import Worlds
+from frontier_marl.core.worlds import Worlds, reachable_region
 from frontier_marl.policies.base import HeuristicPolicy, Info, first_by, slot_table
 from frontier_marl.sim.branching import branch
+from frontier_marl.sim.episodes import EpisodeSource
 from frontier_marl.sim.observations import ObservationEncoder
 from frontier_marl.sim.rollouts import NearestPathBase, RolloutBase, rollout_costs
 
@@ -38,7 +41,10 @@ __all__ = [
     "LookaheadOracle",
     "NearestPathBase",
     "RolloutBase",
+    "completion_costs",
+    "completion_draws",
     "lookahead_costs",
+    "require_generated_maps",
 ]
 
 
@@ -66,6 +72,63 @@ def lookahead_costs(
     sims.goals[:, 0] = targets
     start = int(source.travelled[index, 0])
     return rollout_costs(sims, start, coverage, max_cells, base, prune)
+
+
+def completion_costs(
+    source: Worlds,
+    index: int,
+    targets: np.ndarray,
+    coverage: float,
+    max_cells: int,
+    maps: list[np.ndarray],
+) -> np.ndarray:
+    """:func:`lookahead_costs` (nearest-path finishing) averaged over ``maps`` in place of the
+    true map: per target (M, 2), the mean over the maps (grids of the world's shape) of the
+    cells robot 0 of world ``index`` walks until ``coverage`` of its reachable free region is
+    known, if the cells it does not know are the map's (the known ones stay as its belief has
+    them), it walks to the target first and nearest-path finishes. It reads no true map."""
+    targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
+    m, samples = len(targets), len(maps)
+    base = NearestPathBase()
+    sims = branch(source, index, m * samples, base.gain)
+    belief = source.belief[index]
+    known = belief != UNKNOWN
+    for k, drawn in enumerate(maps):
+        grid = np.array(drawn, dtype=bool)
+        grid[known] = belief[known] == OCCUPIED
+        region = reachable_region(grid, source.positions[index])
+        rows = slice(k * m, (k + 1) * m)
+        sims.true[rows] = grid
+        sims.start_region[rows] = region
+        sims.start_region_size[rows] = np.count_nonzero(region)
+        sims.true_free[rows] = np.count_nonzero(~grid)
+    sims.goals[:, 0] = np.tile(targets, (samples, 1))
+    start = int(source.travelled[index, 0])
+    costs = rollout_costs(sims, start, coverage, max_cells, base)
+    return costs.reshape(samples, m).mean(axis=0)
+
+
+def completion_draws(
+    source: EpisodeSource, belief: np.ndarray, positions: np.ndarray, samples: int, seed: int = 0
+) -> list[np.ndarray]:
+    """``samples`` layouts from ``source``'s generator for :func:`completion_costs`, drawn
+    from a generator seeded by ``seed``, the belief and the robots' cells (the same state
+    draws the same maps in any process). A loaded or static map is refused: its draw would be
+    the true map."""
+    require_generated_maps(source.cfg)
+    digest = hashlib.blake2b(np.ascontiguousarray(belief).tobytes() + positions.tobytes())
+    rng = np.random.default_rng([seed, int.from_bytes(digest.digest()[:8], "little")])
+    return [source.true_grid(rng) for _ in range(samples)]
+
+
+def require_generated_maps(cfg: EnvConfig) -> None:
+    """ValueError unless ``cfg`` draws a fresh generated map per episode (map completions
+    drawn from a loaded or static map would be the true map)."""
+    if cfg.map_path is not None or cfg.map_mode != "dynamic":
+        raise ValueError(
+            "map completions are drawn from the env's generator: they need dynamic generated "
+            "maps (a loaded or static map would be the true map)"
+        )
 
 
 class LinearScorerBase:

@@ -131,7 +131,8 @@ def label_round(
     """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes
     (:func:`~frontier_marl.utils.parallel.map_tasks`)."""
     tasks = [
-        (name, ep, state, reg.scorer_width, reg.rule_share, seed, reg.finisher) for name, ep in jobs
+        (name, ep, state, reg.scorer_width, reg.rule_share, seed, reg.finisher, reg.completions)
+        for name, ep in jobs
     ]
     return Samples.join(map_tasks(_label, tasks, reg.label_workers, label=_label_name))
 
@@ -140,8 +141,8 @@ def _label_name(task: tuple[Any, ...]) -> str:
     return f"the labels of episode {task[1]} of {task[0]}"
 
 
-def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str]) -> Samples:
-    name, episode, state, width, rule_share, seed, finisher = task
+def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str, int]) -> Samples:
+    name, episode, state, width, rule_share, seed, finisher, completions = task
     torch.set_num_threads(1)
     (world,) = variant_configs(family(name), None, 1)
     cfg = scorer_config(world)
@@ -164,7 +165,7 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str]) -
         return int(candidates.slots[int(torch.argmin(regret[0]))])
 
     base = LinearScorerBase(cfg, weights) if finisher == "frontier-rule" else None
-    return label_episode(cfg, episode, behaviour, base, family=name)
+    return label_episode(cfg, episode, behaviour, base, family=name, completions=completions)
 
 
 def fitted(

@@ -10,6 +10,11 @@ of each candidate (its map crops, :mod:`frontier_marl.policies.map_crops`, and i
 slot features) and the candidates' costs; a scorer that regresses the costs from those inputs
 over many maps learns their expectation under the unknown part of the map.
 
+With ``completions`` K the cost of a candidate is instead its mean over K maps drawn from the
+family's generator with the robot's known cells kept
+(:func:`~frontier_marl.policies.lookahead.completion_costs`): a target of less noise, under a
+generic prior rather than the true map.
+
 The episodes are played by a behaviour policy (``frontier-rule`` first, then the learner:
 DAgger, so the learner is trained on the states it visits itself); the labels do not depend on
 it. Samples are stored as arrays of fixed shapes (:class:`Samples`).
@@ -27,8 +32,9 @@ import numpy as np
 from frontier_marl.config import EnvConfig
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.policies.linear_scorer import explorer_slots
-from frontier_marl.policies.lookahead import lookahead_costs
+from frontier_marl.policies.lookahead import completion_costs, completion_draws, lookahead_costs
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
+from frontier_marl.sim.episodes import EpisodeSource
 from frontier_marl.sim.rollouts import RolloutBase
 
 #: A behaviour: (observation, the decision's candidate inputs) -> the valid slot it takes.
@@ -94,10 +100,15 @@ def label_episode(
     behaviour: Behaviour,
     base: RolloutBase | None = None,
     family: str = "",
+    completions: int = 0,
 ) -> Samples:
     """Play one episode (reset ``seed``) with ``behaviour`` and label every real decision's
     candidates with their cost-to-go (``base`` finishing each clone, nearest-path by
-    default)."""
+    default); with ``completions`` K >= 1, with their mean cost-to-go over K maps drawn from
+    ``cfg``'s generator that complete the belief (no true map; nearest-path finishing)."""
+    if completions and base is not None:
+        raise ValueError("map completions are finished by nearest-path: pass no base")
+    source = EpisodeSource(cfg) if completions else None
     env = FrontierParallelEnv(config=cfg)
     height, width = cfg.height, cfg.width
     rows: list[tuple[Candidates, np.ndarray]] = []
@@ -110,14 +121,12 @@ def label_episode(
             candidates = decision_candidates(env, obs)
             world = env.world
             targets = env.mdp.slot_tables()[0].target[candidates.slots]
-            costs = lookahead_costs(
-                world.batch,
-                world.index,
-                targets,
-                cfg.reward.explore_threshold,
-                4 * height * width,
-                base,
-            )
+            coverage, cap = cfg.reward.explore_threshold, 4 * height * width
+            if source is not None:
+                maps = completion_draws(source, world.belief, world.positions, completions, seed)
+                costs = completion_costs(world.batch, world.index, targets, coverage, cap, maps)
+            else:
+                costs = lookahead_costs(world.batch, world.index, targets, coverage, cap, base)
             rows.append((candidates, costs.astype(np.float64)))
             action = behaviour(obs, candidates)
         observations, *_ = env.step({"robot_0": action})

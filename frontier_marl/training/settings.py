@@ -261,6 +261,10 @@ class RegressionSettings:
         finisher: the policy that finishes each labelled candidate's rollout on the true map
             (:data:`FINISHERS`): ``nearest-path`` (compiled, the cheapest) or
             ``frontier-rule`` (the cost-to-go a correction to the rule should predict).
+        completions: 0 labels each candidate with one rollout on the true map; K >= 1 with the
+            mean over K maps drawn from the family's generator that complete the robot's
+            belief (:func:`~frontier_marl.policies.lookahead.completion_costs`; no true map,
+            nearest-path finishing, K times the rollouts).
     """
 
     rounds: int = 3
@@ -273,11 +277,20 @@ class RegressionSettings:
     rule_share: float = 0.5
     rule_weights: tuple[float, ...] = (0.0,)
     finisher: str = "nearest-path"
+    completions: int = 0
 
     def __post_init__(self) -> None:
         if self.finisher not in FINISHERS:
             raise ValueError(
                 f"regression.finisher must be one of {', '.join(FINISHERS)}, got {self.finisher!r}"
+            )
+        count = self.completions
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise ValueError(f"regression.completions must be an integer >= 0, got {count!r}")
+        if count and self.finisher != "nearest-path":
+            raise ValueError(
+                "regression.completions needs regression.finisher = 'nearest-path' "
+                f"(the completions are finished by nearest-path), got {self.finisher!r}"
             )
         weights = self.rule_weights
         if (

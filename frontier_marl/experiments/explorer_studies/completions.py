@@ -20,64 +20,29 @@ static maps (a draw would be the true map).
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from frontier_marl.core.grid import OCCUPIED, UNKNOWN
-from frontier_marl.core.worlds import Worlds, reachable_region
 from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
 from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_benchmark
 from frontier_marl.evaluation.benchmark.stats import format_table
 from frontier_marl.policies.base import HeuristicPolicy, Info, first_by, slot_table
-from frontier_marl.policies.lookahead import LookaheadOracle
-from frontier_marl.sim.branching import branch
+from frontier_marl.policies.lookahead import (
+    LookaheadOracle,
+    completion_costs,
+    completion_draws,
+    require_generated_maps,
+)
 from frontier_marl.sim.episodes import EpisodeSource
-from frontier_marl.sim.rollouts import NearestPathBase, rollout_costs
-
-
-def completion_costs(
-    source: Worlds,
-    index: int,
-    targets: np.ndarray,
-    coverage: float,
-    max_cells: int,
-    maps: list[np.ndarray],
-) -> np.ndarray:
-    """Per target (M, 2), the mean over ``maps`` (each a grid of the world's shape) of the
-    cells robot 0 of world ``index`` walks until ``coverage`` of its reachable free region is
-    known, if the unknown cells are those of the map (the known cells stay as the belief has
-    them), it walks to the target first and nearest-path finishes."""
-    targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
-    m, samples = len(targets), len(maps)
-    base = NearestPathBase()
-    sims = branch(source, index, m * samples, base.gain)
-    belief = source.belief[index]
-    known = belief != UNKNOWN
-    for k, drawn in enumerate(maps):
-        grid = np.array(drawn, dtype=bool)
-        grid[known] = belief[known] == OCCUPIED
-        region = reachable_region(grid, source.positions[index])
-        rows = slice(k * m, (k + 1) * m)
-        sims.true[rows] = grid
-        sims.start_region[rows] = region
-        sims.start_region_size[rows] = np.count_nonzero(region)
-        sims.true_free[rows] = np.count_nonzero(~grid)
-    sims.goals[:, 0] = np.tile(targets, (samples, 1))
-    start = int(source.travelled[index, 0])
-    costs = rollout_costs(sims, start, coverage, max_cells, base)
-    return costs.reshape(samples, m).mean(axis=0)
 
 
 class CompletionLookahead(HeuristicPolicy):
-    """The live slot of least :func:`completion_costs` over ``samples`` maps drawn from the
-    env's own generator (ties: nearest path, then nearest centroid), kept until reached. The
-    draws of a decision are seeded by the belief and the robot's cell, so an episode plays the
-    same in any process."""
+    """The live slot of least :func:`~frontier_marl.policies.lookahead.completion_costs` over
+    ``samples`` maps drawn from the env's own generator
+    (:func:`~frontier_marl.policies.lookahead.completion_draws`; ties: nearest path, then
+    nearest centroid), kept until reached."""
 
     def __init__(self, samples: int, seed: int = 0) -> None:
         super().__init__("until-reached")
@@ -90,14 +55,9 @@ class CompletionLookahead(HeuristicPolicy):
         self._source: EpisodeSource | None = None
 
     def attach(self, env: Any) -> None:
-        cfg = env.config
-        if cfg.map_path is not None or cfg.map_mode != "dynamic":
-            raise ValueError(
-                f"{self.name} draws maps from the env's generator: it needs dynamic generated "
-                "maps (a loaded or static map would be the true map)"
-            )
+        require_generated_maps(env.config)
         self._env = env
-        self._source = EpisodeSource(cfg)
+        self._source = EpisodeSource(env.config)
 
     def choose(self, info: Info) -> int:
         table = slot_table(info)
@@ -107,9 +67,9 @@ class CompletionLookahead(HeuristicPolicy):
             raise RuntimeError(f"{self.name} needs attach(env) before it acts")
         world = self._env.world
         height, width = world.shape
-        digest = hashlib.blake2b(world.belief.tobytes() + world.positions.tobytes())
-        rng = np.random.default_rng([self.seed, int.from_bytes(digest.digest()[:8], "little")])
-        maps = [self._source.true_grid(rng) for _ in range(self.samples)]
+        maps = completion_draws(
+            self._source, world.belief, world.positions, self.samples, self.seed
+        )
         live = table.live
         costs = completion_costs(
             world.batch, world.index, table.target[:live],
