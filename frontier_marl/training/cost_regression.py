@@ -91,7 +91,7 @@ def train_cost_regression(
         chunk = slice(round_ * reg.label_episodes, (round_ + 1) * reg.label_episodes)
         jobs = [(name, int(seed)) for name in names for seed in seeds[name][chunk]]
         state = None if model is None else model.state_dict()
-        samples = label_round(jobs, state, reg, settings.seed + round_)
+        samples = label_round(jobs, state, reg, settings.seed + round_, progress_bar, round_)
         samples.save(run_dir / "labels" / f"round{round_}.npz")
         labels.append(samples)
         model = fitted(Samples.join(labels), reg, settings.seed + round_)
@@ -126,15 +126,30 @@ def _result(run_dir: Path, n_labels: int, started: float, cpu_started: float) ->
 
 
 def label_round(
-    jobs: list[tuple[str, int]], state: dict[str, Any] | None, reg: RegressionSettings, seed: int
+    jobs: list[tuple[str, int]],
+    state: dict[str, Any] | None,
+    reg: RegressionSettings,
+    seed: int,
+    progress: bool = False,
+    round_: int = 0,
 ) -> Samples:
     """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes
-    (:func:`~frontier_marl.utils.parallel.map_tasks`)."""
+    (:func:`~frontier_marl.utils.parallel.map_tasks`), with a bar over the episodes when
+    ``progress``."""
     tasks = [
         (name, ep, state, reg.scorer_width, reg.rule_share, seed, reg.finisher, reg.completions)
         for name, ep in jobs
     ]
-    return Samples.join(map_tasks(_label, tasks, reg.label_workers, label=_label_name))
+    labelled = map_tasks(
+        _label,
+        tasks,
+        reg.label_workers,
+        label=_label_name,
+        progress=progress,
+        desc=f"labels of round {round_}",
+        unit="episode",
+    )
+    return Samples.join(labelled)
 
 
 def _label_name(task: tuple[Any, ...]) -> str:

@@ -150,10 +150,13 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
     if settings.algorithm == "cost-regression":
         reg = RegressionSettings(**experiment.regression)
         world = f"families {', '.join(settings.families)}, frontier-rule's observation"
+        rollouts = f"finished by {reg.finisher}"
+        if reg.completions:
+            rollouts = f"on {reg.completions} completions of the belief, {rollouts}"
         budget = (
             f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "
-            f"episodes per family (rollouts finished by {reg.finisher}), {reg.fit_epochs} epochs "
-            f"each, seed {settings.seed}"
+            f"episodes per family (rollouts {rollouts}), {reg.fit_epochs} epochs each, "
+            f"seed {settings.seed}"
         )
     if settings.algorithm == "cem":
         cem = CEMSettings(**experiment.cem)
