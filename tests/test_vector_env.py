@@ -11,11 +11,14 @@ import gymnasium
 import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
 
 import frontier_marl
 from frontier_marl import FrontierParallelEnv, vector_env
 from frontier_marl.config import PRESETS, make_config
-from frontier_marl.core.frontiers import cluster_frontiers
+from frontier_marl.core.frontiers import cluster_frontiers, frontier_mask
 from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.worlds import WorldParams, Worlds
@@ -165,6 +168,38 @@ def test_stacked_labelling_keeps_worlds_apart() -> None:
         assert np.array_equal(mine.sizes, alone.sizes)
         assert np.array_equal(mine.centroids, alone.centroids)
     assert list(worlds.n_clusters) == [1, 2]
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_worlds=st.integers(1, 5),
+    height=st.integers(1, 12),
+    width=st.integers(1, 12),
+    connectivity=st.sampled_from([4, 8]),
+)
+def test_each_world_is_labelled_as_scipy_labels_its_whole_map(
+    seed: int, n_worlds: int, height: int, width: int, connectivity: int
+) -> None:
+    """The batch labels each world's frontier cropped to its box and packed beside the other
+    worlds' crops; every world's clusters are numbered as ``scipy.ndimage.label`` numbers the
+    frontier of its whole map (worlds with no frontier, and every shape, included)."""
+    rng = np.random.default_rng(seed)
+    belief = rng.choice(
+        np.array([UNKNOWN, FREE, OCCUPIED], dtype=np.int8),
+        size=(n_worlds, height, width),
+        p=rng.dirichlet(np.ones(3)),
+    )
+    params = WorldParams(make_sensor("square", 1), 1, connectivity=connectivity)
+    worlds = Worlds((height, width), n_worlds, 1, params)
+    worlds.belief[:] = belief
+    worlds.version[:] = 1
+    worlds.refresh_clusters()
+    structure = ndimage.generate_binary_structure(2, 1 if connectivity == 4 else 2)
+    for i in range(n_worlds):
+        expected, count = ndimage.label(frontier_mask(belief[i]), structure=structure)
+        assert np.array_equal(worlds.clusters(i).labels(), expected)
+        assert worlds.n_clusters[i] == count
 
 
 def test_sb3_adapter_gives_supersuit_transitions_and_the_same_dqn() -> None:

@@ -5,6 +5,11 @@ shortest paths, ray casting, the walk) has exactly one implementation, a numba-c
 function next to the operation it implements; docs/performance.md says why. The functions
 compile once per machine (about 10 s, then cached beside the module or in numba's user cache).
 For debugging, numba's own ``NUMBA_DISABLE_JIT=1`` runs the same functions as plain Python.
+
+Numba checks a cached function against its own file only: after editing a compiled function,
+a caller in another file keeps the old callee compiled into it until that file changes too.
+When developing, clear the caches after such an edit
+(``find frontier_marl -name '*.nb[ic]' -delete``).
 """
 
 from __future__ import annotations

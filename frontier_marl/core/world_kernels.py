@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from frontier_marl.core.compiled import compiled
-from frontier_marl.core.frontiers import cluster_worlds, count_unknown_around, fill_frontier_masks
+from frontier_marl.core.frontiers import cluster_worlds, count_unknown_around, pack_frontier_masks
 from frontier_marl.core.grid import FREE, UNKNOWN
 from frontier_marl.core.movement import walk
 from frontier_marl.core.slot_kernels import fill_robot_slots
@@ -68,23 +68,32 @@ def stale_masks(
     clustered_version: np.ndarray,
     belief: np.ndarray,
     stale: np.ndarray,
+    frontier: np.ndarray,
     masks: np.ndarray,
+    boxes: np.ndarray,
+    packed_shape: np.ndarray,
 ) -> int:
     """The start of a recluster: the worlds whose belief ``version`` is not the one they were
-    clustered at go into ``stale`` (their count is returned), their frontier masks into the
-    first planes of ``masks`` (:func:`~frontier_marl.core.frontiers.fill_frontier_masks`)."""
+    clustered at go into ``stale`` (their count is returned), their frontier masks into
+    ``frontier`` and packed into ``masks``
+    (:func:`~frontier_marl.core.frontiers.pack_frontier_masks`: the crops' ``boxes``, the
+    image's height and width into ``packed_shape``)."""
     count = 0
     for n in range(len(version)):
         if clustered_version[n] != version[n]:
             stale[count] = n
             count += 1
-    fill_frontier_masks(belief, stale[:count], masks)
+    packed_shape[0], packed_shape[1] = pack_frontier_masks(
+        belief, stale[:count], frontier, masks, boxes
+    )
     return count
 
 
 @compiled
 def recluster(
     labels: np.ndarray,
+    boxes: np.ndarray,
+    width: int,
     stale: np.ndarray,
     max_cells: int,
     by_size: bool,
@@ -100,12 +109,13 @@ def recluster(
     version: np.ndarray,
     clustered_version: np.ndarray,
 ) -> None:
-    """The end of a recluster of the ``stale`` worlds, from their ``labels``: their clusters
+    """The end of a recluster of the ``stale`` worlds, from their packed ``labels`` (``width``
+    columns, the crops' ``boxes``): their clusters
     (:func:`~frontier_marl.core.frontiers.cluster_worlds`), the clusters' gains (their sizes
     ``by_size``, else the unknown cells around them), and clustered as of ``version``."""
     cluster_worlds(
-        labels, stale, max_cells, cell_rows, cell_cols, cell_cluster, n_cells, sizes, centroids,
-        n_clusters,
+        labels, boxes, width, stale, max_cells, cell_rows, cell_cols, cell_cluster, n_cells,
+        sizes, centroids, n_clusters,
     )  # fmt: skip
     for n in stale:
         count, cells = n_clusters[n], n_cells[n]

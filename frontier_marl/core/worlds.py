@@ -3,10 +3,11 @@
 Every operation of a decision step runs for all worlds in one compiled call (the walk of every
 robot, frontier masks, cluster splitting and statistics, the slots of every robot), and the
 frontier masks of all worlds whose belief changed are labelled by **one**
-``scipy.ndimage.label`` call: the masks, each ending in a blank row, are labelled as one image
-(:func:`~frontier_marl.core.frontiers.label_tiled`), so no component crosses from one world to
-the next, and labels are numbered world by world in raster order, exactly as one call per world
-would number them.
+``scipy.ndimage.label`` call: the masks, each cropped to the box around its frontier cells and
+ending in a blank row, are labelled as one image
+(:func:`~frontier_marl.core.frontiers.pack_frontier_masks`), so no component crosses from one
+world to the next, and labels are numbered world by world in raster order, exactly as one call
+per world on its whole map would number them.
 :class:`~frontier_marl.core.world.World` is the same thing for one world.
 
 Arrays are indexed ``[world, ...]`` and ``[world, robot, ...]``; read them, never write them.
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from frontier_marl.core.frontiers import Clusters, label_tiled
+from frontier_marl.core.frontiers import Clusters, label_packed
 from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.maps import FOUR_CONNECTED
 from frontier_marl.core.planning import path_search_scratch
@@ -90,11 +91,15 @@ class Worlds:
         self.gains = np.zeros((n, cells))
         self.n_clusters = np.zeros(n, dtype=np.int64)
         self.clustered_version = np.full(n, -1, dtype=np.int64)
-        # a recluster's buffers: the stale worlds, their masks and labels, one blank row below
-        # each world (see label_tiled)
+        # a recluster's buffers: the stale worlds, their frontier masks, the same packed and
+        # their labels (flat, room for every world's whole map and a blank row), the crops'
+        # boxes and the packed image's height and width (see pack_frontier_masks)
         self.stale = np.zeros(n, dtype=np.int64)
-        self.masks = np.zeros((n, height + 1, width), dtype=bool)
-        self.labels = np.zeros((n, height + 1, width), dtype=np.int32)
+        self.frontier = np.zeros((n, height, width), dtype=bool)
+        self.masks = np.zeros(n * (height + 1) * width, dtype=bool)
+        self.labels = np.zeros(n * (height + 1) * width, dtype=np.int32)
+        self.boxes = np.zeros((n, 4), dtype=np.int64)
+        self.packed_shape = np.zeros(2, dtype=np.int64)
         # per basis code: the explored fractions and the belief versions they were counted at
         self._fractions = {code: (np.zeros(n), np.full(n, -1, dtype=np.int64)) for code in range(3)}
 
@@ -174,21 +179,23 @@ class Worlds:
     def refresh_clusters(self) -> None:
         """Recluster the worlds whose belief changed since they were last clustered."""
         stale = stale_masks(
-            self.version, self.clustered_version, self.belief, self.stale, self.masks
-        )
+            self.version, self.clustered_version, self.belief, self.stale, self.frontier,
+            self.masks, self.boxes, self.packed_shape,
+        )  # fmt: skip
         if stale:
-            self.label_stale(stale)
+            self.label_stale()
             recluster(
-                self.labels[:stale], self.stale[:stale], self.params.max_cluster_cells,
-                self.params.gain != "unknown", self.belief, self.cell_rows, self.cell_cols,
-                self.cell_cluster, self.n_cells, self.sizes, self.centroids, self.gains,
-                self.n_clusters, self.version, self.clustered_version,
+                self.labels, self.boxes, int(self.packed_shape[1]), self.stale[:stale],
+                self.params.max_cluster_cells, self.params.gain != "unknown", self.belief,
+                self.cell_rows, self.cell_cols, self.cell_cluster, self.n_cells, self.sizes,
+                self.centroids, self.gains, self.n_clusters, self.version, self.clustered_version,
             )  # fmt: skip
 
-    def label_stale(self, count: int) -> None:
-        """Label the frontier masks of the first ``count`` worlds of ``stale`` (one
-        ``scipy.ndimage.label`` call, :func:`~frontier_marl.core.frontiers.label_tiled`)."""
-        label_tiled(self.masks[:count], self.params.connectivity, self.labels[:count])
+    def label_stale(self) -> None:
+        """Label the packed frontier masks of the stale worlds (one ``scipy.ndimage.label``
+        call, :func:`~frontier_marl.core.frontiers.label_packed`)."""
+        height, width = self.packed_shape
+        label_packed(self.masks, self.labels, int(height), int(width), self.params.connectivity)
 
     def walk_arrays(self) -> tuple:
         """The reachable region and its size, then the settings and arrays of the walk

@@ -98,14 +98,15 @@ class BatchMDP:
             w.true, w.belief, w.seen, w.positions, w.travelled, w.goals, w.plan_cells,
             w.plan_meta, w.version, w.params.cells_per_step, offsets, between, w.new_cells,
             w.walked, w.walked_len, w.reached, *w.search,
-            w.clustered_version, w.stale, w.masks,
+            w.clustered_version, w.stale, w.frontier, w.masks, w.boxes, w.packed_shape,
         )  # fmt: skip
         constants, _, padding_truncates, no_progress_limit, max_steps = table_constants(cfg.reward)
         self._after_args = (
             slots.live, *chosen, *travel,
             w.start_region, w.start_region_size, w.true_free, w.belief, w.positions, w.travelled,
             w.version, w.reached,
-            w.labels, w.stale, w.params.max_cluster_cells, w.params.gain != "unknown",
+            w.labels, w.boxes, w.packed_shape, w.stale, w.params.max_cluster_cells,
+            w.params.gain != "unknown",
             w.cell_rows, w.cell_cols, w.cell_cluster, w.n_cells, w.sizes, w.centroids, w.gains,
             w.n_clusters, w.clustered_version,
             cfg.observation.sort_by_distance, slots.cluster, slots.valid, slots.centroid,
@@ -157,7 +158,7 @@ class BatchMDP:
         new_cells = np.empty_like(self.new_cells)  # fresh: the last step's stay readable
         stale = before_labelling(actions, active, new_cells, *self._before_args)
         if stale:
-            self.worlds.label_stale(stale)
+            self.worlds.label_stale()
         ends = self._ends
         ends.rewards = np.empty_like(ends.rewards)
         explored = np.empty(self.n_worlds)

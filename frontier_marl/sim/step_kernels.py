@@ -1,7 +1,8 @@
 """A step of a batch of worlds in two compiled calls, one on each side of the labelling.
 
 :func:`before_labelling` turns the actions into targets, walks every robot, counts the step and
-makes the frontier masks of the worlds whose belief changed; ``scipy.ndimage.label`` labels them
+makes the frontier masks of the worlds whose belief changed, each cropped to the box around its
+frontier cells; ``scipy.ndimage.label`` labels them
 (:meth:`~frontier_marl.core.worlds.Worlds.label_stale`); :func:`after_labelling` builds their
 clusters, every robot's slots, the explored fractions, the rewards and the episode ends. Each
 calls the one implementation of its parts (:mod:`frontier_marl.sim.decisions`,
@@ -71,12 +72,16 @@ def before_labelling(
     # the start of a recluster
     clustered_version: np.ndarray,
     stale: np.ndarray,
+    frontier: np.ndarray,
     masks: np.ndarray,
+    boxes: np.ndarray,
+    packed_shape: np.ndarray,
 ) -> int:
     """The ``active`` worlds' robots head for the targets of their ``actions`` and walk
     (``travel``: the distance before the walk is kept in ``before``); the cells each revealed
     go into ``new_cells``; returns how many worlds are ``stale`` (to recluster), their frontier
-    masks in ``masks``."""
+    masks in ``frontier`` and packed for the labelling in ``masks`` (crops in ``boxes``, the
+    image's shape in ``packed_shape``)."""
     decide(live, slot_target, actions, active, history, targets, padding, oscillation)
     if travel:
         before[:] = travelled
@@ -87,7 +92,9 @@ def before_labelling(
         cells_per_step, offsets, between, walk_new_cells, walked, walked_len, reached, search,
     )  # fmt: skip
     count_progress(active, walk_new_cells, new_cells, steps, idle)
-    return stale_masks(version, clustered_version, belief, stale, masks)
+    return stale_masks(
+        version, clustered_version, belief, stale, frontier, masks, boxes, packed_shape
+    )
 
 
 @compiled
@@ -115,8 +122,10 @@ def after_labelling(
     travelled: np.ndarray,
     version: np.ndarray,
     reached: np.ndarray,
-    # the recluster (recluster's arguments)
+    # the recluster (recluster's arguments; the packed image's width read from its shape)
     labels: np.ndarray,
+    boxes: np.ndarray,
+    packed_shape: np.ndarray,
     stale: np.ndarray,
     max_cells: int,
     by_size: bool,
@@ -165,8 +174,9 @@ def after_labelling(
     and the step's ``rewards``, ends and kept arrays
     (:func:`~frontier_marl.sim.decisions.finish_step`)."""
     recluster(
-        labels[:n_stale], stale[:n_stale], max_cells, by_size, belief, cell_rows, cell_cols,
-        cell_cluster, n_cells, sizes, centroids, gains, n_clusters, version, clustered_version,
+        labels, boxes, packed_shape[1], stale[:n_stale], max_cells, by_size, belief, cell_rows,
+        cell_cols, cell_cluster, n_cells, sizes, centroids, gains, n_clusters, version,
+        clustered_version,
     )  # fmt: skip
     all_slots(
         np.flatnonzero(active), belief, positions, cell_rows, cell_cols, cell_cluster, n_cells,

@@ -5,8 +5,9 @@
 
 Times ``ndimage.label`` (as the core calls it: 8-connectivity, 20x20 and 5x5 random masks) and
 SciPy's Cython ``_ni_label._label`` underneath it, warm; one call on a batch of random frontier
-masks (4 % of the cells) labelled as the core labels them, as one 2-D image with a blank row
-below each world (:func:`~frontier_marl.core.frontiers.label_tiled`), against the same masks
+masks (4 % of the cells, so each crop is about the whole map) labelled as the core labels
+them, as one 2-D image with a blank row below each world
+(:func:`~frontier_marl.core.frontiers.label_packed`), against the same masks
 stacked as a 3-D array with a structure that does not connect the worlds; then plays a
 random-valid-slot policy on thesis-20x20 and counts the labellings whose frontier mask equals
 the previous labelling's (the only ones a cache could skip).
@@ -65,8 +66,12 @@ def tiled_vs_stacked(repeats: int = 100) -> dict[str, dict[str, float]]:
         tiled_labels = np.empty(tiled.shape, np.int32)
         stacked_labels = np.empty(stacked.shape, np.int32)
 
-        def tiled_call(masks: np.ndarray = tiled, out: np.ndarray = tiled_labels) -> None:
-            frontiers.label_tiled(masks, 8, out)
+        def tiled_call(
+            masks: np.ndarray = tiled, out: np.ndarray = tiled_labels, side: int = side
+        ) -> None:
+            frontiers.label_packed(
+                masks.reshape(-1), out.reshape(-1), len(masks) * (side + 1), side, 8
+            )
 
         def stacked_call(masks: np.ndarray = stacked, out: np.ndarray = stacked_labels) -> None:
             ndimage.label(masks, structure=stacked_structure, output=out)
