@@ -70,7 +70,7 @@ def fill_distance_field(
     queue[0] = row * width + col
     dist[row, col] = 0
     head, tail = 0, 1
-    while head < tail:  # the neighbours written out: about 1.5x faster than a loop over them
+    while head < tail:  # the neighbours written out: faster than a loop over a tuple of them
         cell = queue[head]
         head += 1
         r, c = cell // width, cell % width
