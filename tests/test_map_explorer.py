@@ -48,7 +48,14 @@ from frontier_marl.training.cost_to_go import (  # noqa: E402
     relative_regret,
 )
 from frontier_marl.training.experiment import load_experiment  # noqa: E402
-from frontier_marl.training.regression import batch_loss, fit, group, symmetry  # noqa: E402
+from frontier_marl.training.regression import (  # noqa: E402
+    batch_loss,
+    family_weights,
+    fit,
+    group,
+    step_size_factor,
+    symmetry,
+)
 
 
 def window_mean(plane: np.ndarray, outside: float, target, scale: int, i: int, j: int) -> float:
@@ -253,9 +260,12 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
         assert set(variant["validation"]["0.0"]["by_family"]) == {"random-20"}
     ensemble_json = tmp_path / "ensemble.json"
     ensemble_args = ["--sizes", "1,2", "--weights", "0,1", "--episodes", "1", "--epochs", "1"]
-    assert ensemble_main([str(out), *ensemble_args, "--json", str(ensemble_json)]) == 0
+    ensemble_args += ["--with", str(out), "--set", "balance_families=true"]
+    ensemble_args += ["--set", 'fit_schedule="cosine"', "--json", str(ensemble_json)]
+    assert ensemble_main([str(out), *ensemble_args]) == 0
     ensemble = json.loads(ensemble_json.read_text())
-    assert ensemble["labels"] == records[1]["labels"] and list(ensemble["sizes"]) == ["1", "2"]
+    assert ensemble["labels"] == 2 * records[1]["labels"]  # the run's labels and --with's
+    assert list(ensemble["sizes"]) == ["1", "2"]
     assert set(ensemble["sizes"]["2"]["1.0"]["by_family"]) == {"random-20"}
 
 
@@ -282,6 +292,51 @@ def test_the_fit_losses_have_their_known_values() -> None:
     assert batch_loss("argmax", sure, regret, mask).item() == pytest.approx(0.0, abs=1e-6)
     with pytest.raises(ValueError, match="unknown loss 'hinge'"):
         fit(new_scorer(14, 8), None, 1, loss="hinge")  # type: ignore[arg-type]
+
+
+def test_family_weights_give_every_family_the_same_total() -> None:
+    samples = Samples(
+        cost=np.ones(7),
+        decision=np.array([5, 5, 2, 9, 9, 9, 7]),  # decisions 2, 5, 7, 9 in group's order
+        family=np.array(["b", "b", "a", "b", "b", "b", "a"]),
+    )
+    weights = family_weights(samples)
+    np.testing.assert_allclose(weights.numpy(), [0.5, 0.5, 0.5, 0.5])
+    samples.family[2] = "b"  # now "a" has one decision (7), "b" three
+    np.testing.assert_allclose(family_weights(samples).numpy(), [1 / 3, 1 / 3, 1.0, 1 / 3])
+
+
+def test_the_step_size_schedules_have_their_known_values() -> None:
+    assert [step_size_factor("constant", s, 10) for s in (0, 5, 10)] == [1.0, 1.0, 1.0]
+    cosine = [step_size_factor("cosine", s, 10) for s in (0, 5, 10)]
+    assert cosine == pytest.approx([1.0, 0.5, 0.0])
+    with pytest.raises(ValueError, match="unknown schedule 'linear'"):
+        fit(new_scorer(14, 8), None, 1, schedule="linear")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="regression.fit_schedule must be one of constant, cos"):
+        load_experiment("explorer-map", ['regression.fit_schedule="linear"'])
+
+
+def test_a_weighted_fit_draws_only_decisions_of_positive_weight(labelled: Samples) -> None:
+    decisions = group(labelled, 12)
+    seen: list[torch.Tensor] = []
+
+    class Recorder(torch.nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.bias = torch.nn.Parameter(torch.zeros(1))
+
+        def forward(self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor):
+            seen.append(features[..., 0].sum(1))
+            return self.bias.expand(mask.shape)
+
+    weights = torch.zeros(len(decisions), dtype=torch.float64)
+    weights[3] = 1.0
+    fit(Recorder(), decisions, 1, batch_size=8, weights=weights)
+    drawn = torch.cat(seen)
+    assert len(drawn) == len(decisions)  # an epoch draws as many decisions as there are
+    assert torch.allclose(drawn, drawn[0].expand_as(drawn))  # all of them decision 3
+    with pytest.raises(ValueError, match="one entry per decision"):
+        fit(Recorder(), decisions, 1, weights=weights[:-1])
 
 
 def test_the_benchmark_plays_a_saved_scorer_with_its_saved_rule_weight(tmp_path: Path) -> None:
@@ -340,3 +395,5 @@ def test_a_bad_regression_section_is_named() -> None:
         )
     with pytest.raises(ValueError, match="needs train.families and one robot"):
         load_experiment("explorer-map", ["train.families=[]"])
+    with pytest.raises(ValueError, match="regression.balance_families must be true or false"):
+        load_experiment("explorer-map", ["regression.balance_families=1"])

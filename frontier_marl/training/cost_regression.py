@@ -42,7 +42,7 @@ from frontier_marl.policies.map_explorer import (
 from frontier_marl.training.cost_to_go import Candidates, Samples, label_episode
 from frontier_marl.training.experiment import Experiment
 from frontier_marl.training.family_validation import FAILURE
-from frontier_marl.training.regression import fit, group
+from frontier_marl.training.regression import family_weights, fit, group
 from frontier_marl.training.results import TrainResult
 from frontier_marl.training.settings import RegressionSettings
 from frontier_marl.utils.parallel import map_tasks
@@ -200,7 +200,18 @@ def fitted(
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))
-    fit(model, decisions, reg.fit_epochs, reg.fit_batch, reg.fit_rate, seed, loss=loss)
+    weights = family_weights(samples) if reg.balance_families else None
+    fit(
+        model,
+        decisions,
+        reg.fit_epochs,
+        reg.fit_batch,
+        reg.fit_rate,
+        seed,
+        loss=loss,
+        weights=weights,
+        schedule=reg.fit_schedule,
+    )
     model.eval()
     return model
 

@@ -13,6 +13,7 @@ learns that a corridor going north is a corridor going east.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +21,7 @@ import torch
 
 from frontier_marl.policies.networks.map_scorer import MapScorer
 from frontier_marl.training.cost_to_go import Samples, cells_regret, relative_regret
+from frontier_marl.training.settings import SCHEDULES
 
 #: Columns of the explorer features that are offsets on the grid: (row, col).
 OFFSET_COLUMNS = (2, 3)
@@ -84,6 +86,15 @@ def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> De
     return Decisions(*(torch.as_tensor(a) for a in (crops, features, regret, mask, extra)))
 
 
+def family_weights(samples: Samples) -> torch.Tensor:
+    """One weight per decision (in :func:`group`'s order) that gives every family of
+    ``samples`` the same total: one over its family's number of decisions."""
+    _, first = np.unique(samples.decision, return_index=True)
+    families = samples.family[first]
+    _, which, counts = np.unique(families, return_inverse=True, return_counts=True)
+    return torch.as_tensor(1.0 / counts[which], dtype=torch.float64)
+
+
 def symmetry(crops: torch.Tensor, features: torch.Tensor, k: int) -> tuple[torch.Tensor, ...]:
     """The ``k``-th of the square's eight symmetries (``k // 2`` quarter turns, mirrored if
     ``k`` is odd) applied to the crops' last two axes and to the offset features."""
@@ -107,15 +118,36 @@ def fit(
     seed: int = 0,
     on_epoch: object = None,
     loss: str = "regret",
+    weights: torch.Tensor | None = None,
+    schedule: str = "constant",
 ) -> list[float]:
-    """Adam on ``loss`` (:data:`LOSSES`); returns the mean training loss of each epoch."""
+    """Adam on ``loss`` (:data:`LOSSES`); returns the mean training loss of each epoch.
+
+    Each epoch sees every decision once in a random order, or with ``weights`` (one per
+    decision) as many decisions drawn with replacement in proportion to them. The step size is
+    ``learning_rate`` throughout (``schedule`` "constant") or falls from it to zero along a
+    half cosine over the fit's steps ("cosine", :data:`SCHEDULES`)."""
     if loss not in LOSSES:
         raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+    if schedule not in SCHEDULES:
+        raise ValueError(f"unknown schedule {schedule!r}; choose one of {', '.join(SCHEDULES)}")
+    if weights is not None and weights.shape != (len(train),):
+        raise ValueError(
+            f"weights must have one entry per decision ({len(train)}), "
+            f"got shape {tuple(weights.shape)}"
+        )
     generator = torch.Generator().manual_seed(seed)
     optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate)
+    steps = epochs * -(-len(train) // batch_size)
+    rate = torch.optim.lr_scheduler.LambdaLR(
+        optimiser, lambda step: step_size_factor(schedule, step, steps)
+    )
     losses = []
     for epoch in range(epochs):
-        order = torch.randperm(len(train), generator=generator)
+        if weights is None:
+            order = torch.randperm(len(train), generator=generator)
+        else:
+            order = torch.multinomial(weights, len(train), True, generator=generator)
         total, batches = 0.0, 0
         model.train()
         for start in range(0, len(train), batch_size):
@@ -127,11 +159,20 @@ def fit(
             optimiser.zero_grad()
             value.backward()
             optimiser.step()
+            rate.step()
             total, batches = total + value.item(), batches + 1
         losses.append(total / max(batches, 1))
         if callable(on_epoch):
             on_epoch(epoch, losses[-1])
     return losses
+
+
+def step_size_factor(schedule: str, step: int, steps: int) -> float:
+    """The fraction of the initial step size at ``step`` of ``steps`` under ``schedule``
+    (:data:`~frontier_marl.training.settings.SCHEDULES`)."""
+    if schedule == "constant":
+        return 1.0
+    return 0.5 + 0.5 * math.cos(math.pi * min(step, steps) / steps)
 
 
 def batch_loss(

@@ -237,6 +237,8 @@ CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
 
 #: The rollout finishers of the cost-to-go labels (``regression.finisher``).
 FINISHERS = ("nearest-path", "frontier-rule")
+#: The step size over a fit of the map scorer: fixed, or a half cosine down to zero.
+SCHEDULES = ("constant", "cosine")
 
 
 @dataclass(frozen=True)
@@ -265,6 +267,12 @@ class RegressionSettings:
             mean over K maps drawn from the family's generator that complete the robot's
             belief (:func:`~frontier_marl.policies.lookahead.completion_costs`; no true map,
             nearest-path finishing, K times the rollouts).
+        balance_families: draw each gradient step's decisions so that every family weighs
+            the same in the fit, however many decisions it labelled (False: every decision
+            once per epoch).
+        fit_schedule: the step size over a fit: ``constant`` (``fit_rate`` throughout) or
+            ``cosine`` (from ``fit_rate`` down to zero along a half cosine, so the fit ends
+            at rest rather than wherever its last noisy step left it).
     """
 
     rounds: int = 3
@@ -278,8 +286,19 @@ class RegressionSettings:
     rule_weights: tuple[float, ...] = (0.0,)
     finisher: str = "nearest-path"
     completions: int = 0
+    balance_families: bool = False
+    fit_schedule: str = "constant"
 
     def __post_init__(self) -> None:
+        if not isinstance(self.balance_families, bool):
+            raise ValueError(
+                f"regression.balance_families must be true or false, got {self.balance_families!r}"
+            )
+        if self.fit_schedule not in SCHEDULES:
+            raise ValueError(
+                f"regression.fit_schedule must be one of {', '.join(SCHEDULES)}, "
+                f"got {self.fit_schedule!r}"
+            )
         if self.finisher not in FINISHERS:
             raise ValueError(
                 f"regression.finisher must be one of {', '.join(FINISHERS)}, got {self.finisher!r}"

@@ -12,7 +12,8 @@ at each rule weight of ``--weights`` (k = 1 is one plain fit)::
         --weights 0,0.5,1 --episodes 16 --json ensemble.json
 
 ``--set KEY=VALUE`` changes a fit setting of the run's ``[regression]`` section (e.g.
-``--set scorer_width=64`` for a wider scorer).
+``--set scorer_width=64`` for a wider scorer). ``--with RUN`` (repeatable) adds another
+cost-regression run's labels to the fit and its families to the validation.
 """
 
 from __future__ import annotations
@@ -65,14 +66,27 @@ def main(argv: list[str] | None = None) -> int:
         metavar="KEY=VALUE",
         help="a fit setting of [regression] instead of the run's (e.g. scorer_width=64)",
     )
+    parser.add_argument(
+        "--with",
+        dest="others",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="RUN",
+        help="another cost-regression run whose labels and families join the fit",
+    )
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
     try:
         sizes = [int(k) for k in args.sizes.split(",")]
         weights = [float(w) for w in args.weights.split(",")]
-        train = Samples.join(run_labels(args.run, minimum=1))
+        runs = [args.run, *args.others]
+        train = Samples.join([part for run in runs for part in run_labels(run, minimum=1)])
         experiment = run_experiment(args.run)
+        families = list(
+            dict.fromkeys(name for run in runs for name in run_experiment(run).train.families)
+        )
     except (ValueError, OSError, KeyError) as exc:
         parser.error(str(exc))
     if min(sizes) < 1:
@@ -95,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         for offset in range(max(sizes)):
             members.append(fitted(train, reg, seed + offset))
             bar.update(1)
-    validation = Validation(list(experiment.train.families), args.episodes)
+    validation = Validation(families, args.episodes)
     report: dict[str, Any] = {"run": str(args.run), "labels": len(train), "sizes": {}}
     for k in sizes:
         model = Averaged(members[:k]).eval()
