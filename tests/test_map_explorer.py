@@ -156,9 +156,11 @@ def test_labels_finished_by_frontier_rule_cost_what_its_rollouts_walk() -> None:
     fam = map_families.family("rooms-32")
     (world,) = map_families.variant_configs(fam, None, 1)
     cfg = scorer_config(world)
-    task = ("rooms-32", int(fam.train[0]), None, 8, 0.5, 0)
-    by_rule = cost_regression._label((*task, "frontier-rule", 0))
-    by_nearest = cost_regression._label((*task, "nearest-path", 0))
+    settings = {"scorer_width": 8, "rule_share": 0.5}
+    rule = cost_regression.RegressionSettings(**settings, finisher="frontier-rule")
+    nearest = cost_regression.RegressionSettings(**settings)
+    by_rule = cost_regression._label(("rooms-32", int(fam.train[0]), None, rule, 0))
+    by_nearest = cost_regression._label(("rooms-32", int(fam.train[0]), None, nearest, 0))
     np.testing.assert_array_equal(by_rule.decision, by_nearest.decision)  # same behaviour
     assert not np.array_equal(by_rule.cost, by_nearest.cost)  # other finishers, other costs
     env = frontier_marl.parallel_env(config=cfg)
@@ -190,6 +192,20 @@ def test_labels_give_every_candidate_of_a_decision_its_cost_to_go(labelled: Samp
     assert len(grouped) == decisions
     assert (grouped.regret[grouped.mask] >= 0).all()
     assert (grouped.regret.masked_fill(~grouped.mask, 9).min(dim=1).values == 0).all()
+
+
+def test_one_decision_in_three_labelled_is_every_third_of_the_full_labels(
+    labelled: Samples,
+) -> None:
+    fam = map_families.family("random-20")
+    (world,) = map_families.variant_configs(fam, None, 1)
+    nearest = first_choice_of(lambda obs, candidates: candidates.features[:, 0])
+    cfg = scorer_config(world)
+    thinned = label_episode(cfg, fam.train[0], nearest, family="random-20", every=3)
+    kept = labelled.decision % 3 == 0  # the same episode: the behaviour does not read labels
+    np.testing.assert_array_equal(thinned.decision, labelled.decision[kept] // 3)
+    np.testing.assert_array_equal(thinned.cost, labelled.cost[kept])
+    np.testing.assert_array_equal(thinned.crops, labelled.crops[kept])
 
 
 def test_samples_survive_a_round_trip_and_a_join(labelled: Samples, tmp_path: Path) -> None:
@@ -370,13 +386,15 @@ def test_the_explorer_acts_on_valid_slots_only() -> None:
 
 def test_labels_over_map_completions_are_other_costs_of_the_same_decisions() -> None:
     fam = map_families.family("random-20")
-    task = ("random-20", int(fam.train[0]), None, 8, 0.5, 0, "nearest-path")
-    true_map = cost_regression._label((*task, 0))
-    completed = cost_regression._label((*task, 3))
+    episode = ("random-20", int(fam.train[0]), None)
+    true_map = cost_regression._label((*episode, cost_regression.RegressionSettings(), 0))
+    three = cost_regression.RegressionSettings(completions=3)
+    completed = cost_regression._label((*episode, three, 0))
     np.testing.assert_array_equal(completed.decision, true_map.decision)  # same behaviour
     np.testing.assert_array_equal(completed.crops, true_map.crops)
     assert not np.array_equal(completed.cost, true_map.cost)
-    assert np.array_equal(cost_regression._label((*task, 3)).cost, completed.cost)  # seeded
+    again = cost_regression._label((*episode, three, 0))
+    assert np.array_equal(again.cost, completed.cost)  # seeded
     assert (completed.cost > 0).all()
 
 
@@ -395,5 +413,7 @@ def test_a_bad_regression_section_is_named() -> None:
         )
     with pytest.raises(ValueError, match="needs train.families and one robot"):
         load_experiment("explorer-map", ["train.families=[]"])
+    with pytest.raises(ValueError, match=r"regression.label_every must be an integer >= 1"):
+        load_experiment("explorer-map", ["regression.label_every=0"])
     with pytest.raises(ValueError, match="regression.balance_families must be true or false"):
         load_experiment("explorer-map", ["regression.balance_families=1"])

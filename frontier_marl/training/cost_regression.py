@@ -5,7 +5,8 @@ Each round (``[regression]``, :class:`~frontier_marl.training.settings.Regressio
 1. **label**: ``label_episodes`` fresh training episodes of every family (seeds from the
    family's training range) are played in the scorer's env (frontier-rule's observation on the
    family's world); round 0 follows frontier-rule, later rounds the scorer with the rule taking
-   a ``rule_share`` of the decisions (DAgger). Every real decision is labelled with each
+   a ``rule_share`` of the decisions (DAgger). Every real decision (or one in
+   ``label_every``) is labelled with each
    candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.cost_to_go`; the
    rollouts finished by ``finisher``), in ``label_workers`` processes;
    ``RUN/labels/round<r>.npz``;
@@ -136,10 +137,7 @@ def label_round(
     """The labels of ``jobs`` (family, seed), in ``reg.label_workers`` processes
     (:func:`~frontier_marl.utils.parallel.map_tasks`), with a bar over the episodes when
     ``progress``."""
-    tasks = [
-        (name, ep, state, reg.scorer_width, reg.rule_share, seed, reg.finisher, reg.completions)
-        for name, ep in jobs
-    ]
+    tasks = [(name, ep, state, reg, seed) for name, ep in jobs]
     labelled = map_tasks(
         _label,
         tasks,
@@ -156,8 +154,8 @@ def _label_name(task: tuple[Any, ...]) -> str:
     return f"the labels of episode {task[1]} of {task[0]}"
 
 
-def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str, int]) -> Samples:
-    name, episode, state, width, rule_share, seed, finisher, completions = task
+def _label(task: tuple[str, int, dict[str, Any] | None, RegressionSettings, int]) -> Samples:
+    name, episode, state, reg, seed = task
     torch.set_num_threads(1)
     (world,) = variant_configs(family(name), None, 1)
     cfg = scorer_config(world)
@@ -165,13 +163,13 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str, in
     rule = weights.astype(np.float32)
     model = None
     if state is not None:
-        model = new_scorer(len(rule), width)
+        model = new_scorer(len(rule), reg.scorer_width)
         model.load_state_dict(state)
         model.eval()
     choices = np.random.default_rng([seed, episode])
 
     def behaviour(obs: dict[str, np.ndarray], candidates: Candidates) -> int:
-        if model is None or choices.random() < rule_share:
+        if model is None or choices.random() < reg.rule_share:
             return int(candidates.slots[int(np.argmax(candidates.features @ rule))])
         crops = torch.as_tensor(candidates.crops)[None]
         features = torch.as_tensor(candidates.features)[None]
@@ -179,8 +177,8 @@ def _label(task: tuple[str, int, dict[str, Any] | None, int, float, int, str, in
             regret = model(crops, features, torch.ones((1, len(candidates.slots)), dtype=bool))
         return int(candidates.slots[int(torch.argmin(regret[0]))])
 
-    base = LinearScorerBase(cfg, weights) if finisher == "frontier-rule" else None
-    return label_episode(cfg, episode, behaviour, base, family=name, completions=completions)
+    base = LinearScorerBase(cfg, weights) if reg.finisher == "frontier-rule" else None
+    return label_episode(cfg, episode, behaviour, base, name, reg.completions, reg.label_every)
 
 
 def fitted(

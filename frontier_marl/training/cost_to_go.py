@@ -101,17 +101,19 @@ def label_episode(
     base: RolloutBase | None = None,
     family: str = "",
     completions: int = 0,
+    every: int = 1,
 ) -> Samples:
-    """Play one episode (reset ``seed``) with ``behaviour`` and label every real decision's
-    candidates with their cost-to-go (``base`` finishing each clone, nearest-path by
-    default); with ``completions`` K >= 1, with their mean cost-to-go over K maps drawn from
-    ``cfg``'s generator that complete the belief (no true map; nearest-path finishing)."""
+    """Play one episode (reset ``seed``) with ``behaviour`` and label every ``every``-th real
+    decision's candidates (the first, then each ``every`` later) with their cost-to-go
+    (``base`` finishing each clone, nearest-path by default); with ``completions`` K >= 1,
+    with their mean cost-to-go over K maps drawn from ``cfg``'s generator that complete the
+    belief (no true map; nearest-path finishing)."""
     if completions and base is not None:
         raise ValueError("map completions are finished by nearest-path: pass no base")
     source = EpisodeSource(cfg) if completions else None
     env = FrontierParallelEnv(config=cfg)
-    height, width = cfg.height, cfg.width
     rows: list[tuple[Candidates, np.ndarray]] = []
+    decisions = 0
     observations, _ = env.reset(seed=seed)
     while env.agents:
         obs = observations["robot_0"]
@@ -119,19 +121,33 @@ def label_episode(
         action = int(np.argmax(mask))
         if int(mask.sum()) > 1:
             candidates = decision_candidates(env, obs)
-            world = env.world
-            targets = env.mdp.slot_tables()[0].target[candidates.slots]
-            coverage, cap = cfg.reward.explore_threshold, 4 * height * width
-            if source is not None:
-                maps = completion_draws(source, world.belief, world.positions, completions, seed)
-                costs = completion_costs(world.batch, world.index, targets, coverage, cap, maps)
-            else:
-                costs = lookahead_costs(world.batch, world.index, targets, coverage, cap, base)
-            rows.append((candidates, costs.astype(np.float64)))
+            if decisions % every == 0:
+                rows.append((candidates, _costs(env, candidates, base, source, completions, seed)))
+            decisions += 1
             action = behaviour(obs, candidates)
         observations, *_ = env.step({"robot_0": action})
     env.close()
     return _samples(rows, family)
+
+
+def _costs(
+    env: FrontierParallelEnv,
+    candidates: Candidates,
+    base: RolloutBase | None,
+    source: EpisodeSource | None,
+    completions: int,
+    seed: int,
+) -> np.ndarray:
+    """The candidates' cost-to-go (:func:`label_episode`)."""
+    cfg, world = env.config, env.world
+    targets = env.mdp.slot_tables()[0].target[candidates.slots]
+    coverage, cap = cfg.reward.explore_threshold, 4 * cfg.height * cfg.width
+    if source is not None:
+        maps = completion_draws(source, world.belief, world.positions, completions, seed)
+        costs = completion_costs(world.batch, world.index, targets, coverage, cap, maps)
+    else:
+        costs = lookahead_costs(world.batch, world.index, targets, coverage, cap, base)
+    return costs.astype(np.float64)
 
 
 def _samples(rows: list[tuple[Candidates, np.ndarray]], family: str) -> Samples:

@@ -267,6 +267,9 @@ class RegressionSettings:
             mean over K maps drawn from the family's generator that complete the robot's
             belief (:func:`~frontier_marl.policies.lookahead.completion_costs`; no true map,
             nearest-path finishing, K times the rollouts).
+        label_every: label one real decision in this many (the first, then every
+            ``label_every``-th; the others are played, not labelled): fewer, less correlated
+            labels where an episode's decisions are many and their rollouts long.
         balance_families: draw each gradient step's decisions so that every family weighs
             the same in the fit, however many decisions it labelled (False: every decision
             once per epoch).
@@ -286,6 +289,7 @@ class RegressionSettings:
     rule_weights: tuple[float, ...] = (0.0,)
     finisher: str = "nearest-path"
     completions: int = 0
+    label_every: int = 1
     balance_families: bool = False
     fit_schedule: str = "constant"
 
@@ -322,7 +326,8 @@ class RegressionSettings:
             raise ValueError(
                 f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
             )
-        integers = ("rounds", "label_episodes", "label_workers", "fit_epochs", "fit_batch")
+        integers = ("rounds", "label_episodes", "label_every", "label_workers", "fit_epochs")
+        integers += ("fit_batch",)
         for name in (*integers, "scorer_width"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
