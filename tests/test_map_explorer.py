@@ -278,7 +278,9 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
     ensemble_args = ["--sizes", "1,2", "--weights", "0,1", "--episodes", "1", "--epochs", "1"]
     ensemble_args += ["--with", str(out), "--set", "balance_families=true"]
     ensemble_args += ["--set", 'fit_schedule="cosine"', "--json", str(ensemble_json)]
-    assert ensemble_main([str(out), *ensemble_args]) == 0
+    assert ensemble_main([str(out), *ensemble_args, "--save", str(tmp_path / "kept")]) == 0
+    kept, kept_meta = load_scorer(tmp_path / "kept")
+    assert kept_meta["rule_weight"] == 0.0 and kept_meta["regression"]["balance_families"]
     ensemble = json.loads(ensemble_json.read_text())
     assert ensemble["labels"] == 2 * records[1]["labels"]  # the run's labels and --with's
     assert list(ensemble["sizes"]) == ["1", "2"]

@@ -153,6 +153,8 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
         rollouts = f"finished by {reg.finisher}"
         if reg.completions:
             rollouts = f"on {reg.completions} completions of the belief, {rollouts}"
+        if reg.label_every > 1:
+            rollouts = f"{rollouts}; one decision in {reg.label_every} labelled"
         budget = (
             f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "
             f"episodes per family (rollouts {rollouts}), {reg.fit_epochs} epochs each, "

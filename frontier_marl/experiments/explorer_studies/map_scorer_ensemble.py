@@ -13,7 +13,9 @@ at each rule weight of ``--weights`` (k = 1 is one plain fit)::
 
 ``--set KEY=VALUE`` changes a fit setting of the run's ``[regression]`` section (e.g.
 ``--set scorer_width=64`` for a wider scorer). ``--with RUN`` (repeatable) adds another
-cost-regression run's labels to the fit and its families to the validation.
+cost-regression run's labels to the fit and its families to the validation. ``--save
+FOLDER`` keeps the first fit (seed ``seed``) as a map explorer the benchmark plays, with the
+first of ``--weights`` as its rule weight.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from frontier_marl.experiments.explorer_studies.map_scorer_ablation import (
     run_experiment,
     run_labels,
 )
+from frontier_marl.policies.map_explorer import save_map_explorer
 from frontier_marl.training.cost_regression import Validation, fitted
 from frontier_marl.training.cost_to_go import Samples
 from frontier_marl.training.experiment import parse_override
@@ -75,6 +78,9 @@ def main(argv: list[str] | None = None) -> int:
         metavar="RUN",
         help="another cost-regression run whose labels and families join the fit",
     )
+    parser.add_argument(
+        "--save", type=Path, default=None, metavar="FOLDER", help="keep the first fit here"
+    )
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
@@ -109,6 +115,12 @@ def main(argv: list[str] | None = None) -> int:
         for offset in range(max(sizes)):
             members.append(fitted(train, reg, seed + offset))
             bar.update(1)
+    if args.save is not None:
+        meta = {"trained_by": "explorer_map_ensemble", "labels": len(train)}
+        regression = {**settings, "runs": [str(run) for run in runs]}
+        save_map_explorer(
+            members[0], args.save, {**meta, "regression": regression, "rule_weight": weights[0]}
+        )
     validation = Validation(families, args.episodes)
     report: dict[str, Any] = {"run": str(args.run), "labels": len(train), "sizes": {}}
     for k in sizes:
