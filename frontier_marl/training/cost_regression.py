@@ -6,9 +6,9 @@ Each round (``[regression]``, :class:`~frontier_marl.training.settings.Regressio
    family's training range) are played in the scorer's env (frontier-rule's observation on the
    family's world); round 0 follows frontier-rule, later rounds the scorer with the rule taking
    a ``rule_share`` of the decisions (DAgger). Every real decision (or one in
-   ``label_every``) is labelled with each
-   candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.cost_to_go`; the
-   rollouts finished by ``finisher``), in ``label_workers`` processes;
+   ``label_every``) is labelled with each candidate's cost-to-go on the true map
+   (:mod:`~frontier_marl.training.cost_to_go`; the rollouts finished by ``finisher``), in
+   ``label_workers`` processes;
    ``RUN/labels/round<r>.npz``;
 2. **fit**: a new scorer on every label so far (:mod:`~frontier_marl.training.regression`);
 3. **validate**: the scorer and frontier-rule on the first ``train.validation_episodes``
