@@ -110,6 +110,8 @@ def label_episode(
     belief (no true map; nearest-path finishing)."""
     if completions and base is not None:
         raise ValueError("map completions are finished by nearest-path: pass no base")
+    if every < 1:
+        raise ValueError(f"every must be an integer >= 1, got {every!r}")
     source = EpisodeSource(cfg) if completions else None
     env = FrontierParallelEnv(config=cfg)
     rows: list[tuple[Candidates, np.ndarray]] = []
