@@ -138,7 +138,7 @@ def fit(
         )
     generator = torch.Generator().manual_seed(seed)
     optimiser = torch.optim.Adam(model.parameters(), lr=learning_rate)
-    steps = epochs * -(-len(train) // batch_size)
+    steps = max(1, epochs * -(-len(train) // batch_size))
     rate = torch.optim.lr_scheduler.LambdaLR(
         optimiser, lambda step: step_size_factor(schedule, step, steps)
     )
