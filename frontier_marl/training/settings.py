@@ -327,8 +327,7 @@ class RegressionSettings:
                 f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
             )
         integers = ("rounds", "label_episodes", "label_every", "label_workers", "fit_epochs")
-        integers += ("fit_batch",)
-        for name in (*integers, "scorer_width"):
+        for name in (*integers, "fit_batch", "scorer_width"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"regression.{name} must be an integer >= 1, got {value!r}")
