@@ -36,7 +36,7 @@ from frontier_marl.policies.map_explorer import (  # noqa: E402
     new_scorer,
     save_map_explorer,
 )
-from frontier_marl.policies.models import map_scorer_folder  # noqa: E402
+from frontier_marl.policies.models import map_scorer_folder, resolve_model_path  # noqa: E402
 from frontier_marl.training import cost_regression  # noqa: E402
 from frontier_marl.training.cost_regression import scorer_config  # noqa: E402
 from frontier_marl.training.cost_to_go import (  # noqa: E402
@@ -237,13 +237,14 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
         "regression.label_episodes": 1,
         "regression.label_workers": 1,
         "regression.fit_epochs": 1,
+        "regression.completions": 2,
     }
     sets = [arg for key, value in tiny.items() for arg in ("--set", f"{key}={value}")]
     assert main(["train", "explorer-map", "--out", str(out), "--no-progress", *sets]) == 0
     records = [json.loads(line) for line in (out / "validation.jsonl").read_text().splitlines()]
     assert [r["round"] for r in records] == [0, 1] and records[1]["labels"] > records[0]["labels"]
     tried = records[0]["by_rule_weight_and_family"]
-    assert set(tried) == {"0.0", "0.5", "2.0"} and set(tried["0.5"]) == {"random-20"}
+    assert set(tried) == {"0.5", "1.0"} and set(tried["0.5"]) == {"random-20"}
     assert map_scorer_folder(out / "best") == out / "best"
     model, meta = load_scorer(out / "best")
     assert meta["format"] == "map-scorer" and meta["env_settings"]["n_slots"] == 12
@@ -363,6 +364,8 @@ def test_the_benchmark_plays_a_saved_scorer_with_its_saved_rule_weight(tmp_path:
     policy = map_model(tmp_path / "scorer", "scorer").make()
     assert isinstance(policy, MapExplorer) and policy.rule_weight == 0.5
     assert MapExplorer.load(tmp_path / "scorer").rule_weight == 0.5
+    with pytest.raises(ValueError, match="is a map-aware scorer .* not an SB3 model"):
+        resolve_model_path(tmp_path / "scorer")
 
 
 def test_the_explorer_acts_on_valid_slots_only() -> None:
@@ -419,3 +422,33 @@ def test_a_bad_regression_section_is_named() -> None:
         load_experiment("explorer-map", ["regression.label_every=0"])
     with pytest.raises(ValueError, match="regression.balance_families must be true or false"):
         load_experiment("explorer-map", ["regression.balance_families=1"])
+
+
+def test_a_family_may_label_its_own_episodes_and_decisions() -> None:
+    own = {"floorplan-96": {"label_episodes": 3, "label_every": 8}}
+    reg = cost_regression.RegressionSettings(label_episodes=5, label_every=2, per_family=own)
+    assert (reg.label_episodes_of("floorplan-96"), reg.label_every_of("floorplan-96")) == (3, 8)
+    assert (reg.label_episodes_of("rooms-32"), reg.label_every_of("rooms-32")) == (5, 2)
+    shipped = cost_regression.RegressionSettings(**load_experiment("explorer-map").regression)
+    assert shipped.label_every_of("floorplan-96") > 1 == shipped.label_every_of("random-20")
+
+
+def test_a_bad_per_family_entry_is_named() -> None:
+    with pytest.raises(ValueError, match=r"regression.per_family: unknown family 'floorplan96'"):
+        load_experiment("explorer-map", ["regression.per_family={floorplan96={label_every=2}}"])
+    with pytest.raises(ValueError, match=r"per_family.rooms-32 has unknown keys \['epochs'\]"):
+        load_experiment("explorer-map", ["regression.per_family={rooms-32={epochs=2}}"])
+    with pytest.raises(ValueError, match=r"per_family.rooms-32.label_every must be an integer"):
+        load_experiment("explorer-map", ["regression.per_family={rooms-32={label_every=0}}"])
+    with pytest.raises(ValueError, match=r"regression.per_family.rooms-32 must be a table"):
+        load_experiment("explorer-map", ["regression.per_family={rooms-32=4}"])
+
+
+def test_the_shipped_explorer_map_is_the_committed_configs_scorer() -> None:
+    model, meta = load_scorer("explorer-map")
+    assert meta["format"] == "map-scorer" and meta["rule_weight"] == 0.5
+    committed = load_experiment("explorer-map").to_dict()
+    assert {k: meta["experiment"][k] for k in ("train", "regression")} == {
+        k: committed[k] for k in ("train", "regression")
+    }
+    assert model.feature_mean.numel() == len(feature_names(scorer_config(make_config(None))))

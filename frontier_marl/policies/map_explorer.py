@@ -26,7 +26,7 @@ from frontier_marl.policies.base import Info, Policy
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS, FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import explorer_slots, feature_names, weight_vector
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
-from frontier_marl.policies.models import MAP_SCORER_FILE, MAP_SCORER_FORMAT
+from frontier_marl.policies.models import MAP_SCORER_FILE, MAP_SCORER_FORMAT, map_scorer_folder
 from frontier_marl.policies.networks.map_scorer import MapScorer
 
 METADATA_FILE = "model.json"
@@ -47,9 +47,10 @@ def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) 
     (folder / METADATA_FILE).write_text(json.dumps({**record, **metadata}, indent=2) + "\n")
 
 
-def load_scorer(folder: Path) -> tuple[MapScorer, dict[str, Any]]:
-    """The scorer saved in ``folder`` and its metadata; ValueError naming a damaged file."""
-    folder = Path(folder)
+def load_scorer(folder: str | Path) -> tuple[MapScorer, dict[str, Any]]:
+    """The scorer saved in ``folder`` (or shipped under that name, e.g. ``explorer-map``) and
+    its metadata; ValueError naming a damaged or missing file."""
+    folder = map_scorer_folder(folder) or Path(folder)
     try:
         metadata = json.loads((folder / METADATA_FILE).read_text())
         shape = metadata["scorer"]

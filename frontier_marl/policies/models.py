@@ -3,7 +3,9 @@
     frontier-marl evaluate thesis-config01
 
 Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with
-its ``model.json`` metadata (env config, observation layout, training run). How each was
+its ``model.json`` metadata (env config, observation layout, training run), or, for the
+map-aware ``explorer-map``, as ``model.pt`` (torch weights,
+:mod:`frontier_marl.policies.map_explorer`) with its ``model.json``. How each was
 trained is in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md
 (``explorer``, ``team-explorer``). The research models of the explorer studies
 (``explorer-dqn``, ``explorer-ppo``) are not in the package: they lie in the repository's
@@ -39,6 +41,11 @@ PRETRAINED: dict[str, str] = {
     "unknown_near and fill features, trained by the cross-entropy method on T99 on five "
     "benchmark map families by `frontier-marl train explorer` (seed 0); the best-validated "
     "weights (generation 0 of 12)",
+    "explorer-map": "the map-aware learned selector (docs/experiments/2026-12-04-map-aware-"
+    "explorer.md): a small CNN over the belief map around each of frontier-rule's 12 slots, "
+    "fitted to each candidate's mean cost-to-go over 16 completions of the belief on six "
+    "families by `frontier-marl train explorer-map` (seed 0, 72 minutes); it overrules "
+    "frontier-rule where it predicts a clear gain (the rule's margin weighed 0.5); torch only",
     "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
     "slot scorer with three teammate features per slot, one parameter-shared model for teams "
     "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
@@ -137,6 +144,11 @@ def resolve_model_path(path: str | Path) -> Path:
         checkpoint = newest_good_checkpoint(path)
         if checkpoint is not None:
             return checkpoint.model
+        if map_scorer_folder(path) is not None:
+            raise ValueError(
+                f"{str(path)!r} is a map-aware scorer ({MAP_SCORER_FILE}), not an SB3 model: "
+                "play it with `frontier-marl benchmark --policies` or `frontier-marl gif`"
+            )
         raise ValueError(f"no {MODEL_FILE} in folder {str(path)!r}")
     if not path.is_file() and path.with_suffix(".zip").is_file():
         path = path.with_suffix(".zip")

@@ -6,9 +6,9 @@ Each round (``[regression]``, :class:`~frontier_marl.training.settings.Regressio
    family's training range) are played in the scorer's env (frontier-rule's observation on the
    family's world); round 0 follows frontier-rule, later rounds the scorer with the rule taking
    a ``rule_share`` of the decisions (DAgger). Every real decision (or one in
-   ``label_every``) is labelled with each candidate's cost-to-go on the true map
-   (:mod:`~frontier_marl.training.cost_to_go`; the rollouts finished by ``finisher``), in
-   ``label_workers`` processes;
+   ``label_every``; a family may set both counts for itself in ``per_family``) is labelled
+   with each candidate's cost-to-go on the true map (:mod:`~frontier_marl.training.
+   cost_to_go`; the rollouts finished by ``finisher``), in ``label_workers`` processes;
    ``RUN/labels/round<r>.npz``;
 2. **fit**: a new scorer on every label so far (:mod:`~frontier_marl.training.regression`);
 3. **validate**: the scorer and frontier-rule on the first ``train.validation_episodes``
@@ -80,8 +80,12 @@ def train_cost_regression(
     started, cpu_started = time.perf_counter(), time.process_time()
     rng = np.random.default_rng(settings.seed)
     names = list(settings.families)
-    count = reg.rounds * reg.label_episodes
-    seeds = {name: rng.permutation(np.asarray(family(name).train))[:count] for name in names}
+    seeds = {
+        name: rng.permutation(np.asarray(family(name).train))[
+            : reg.rounds * reg.label_episodes_of(name)
+        ]
+        for name in names
+    }
     validation = Validation(names, settings.validation_episodes)
     labels, model, best = [], None, -np.inf
     (run_dir / "labels").mkdir(parents=True, exist_ok=True)
@@ -89,8 +93,11 @@ def train_cost_regression(
     log.write_text("")
     bar = make_bar(reg.rounds, disable=not progress_bar, desc="rounds", unit="round")
     for round_ in range(reg.rounds):
-        chunk = slice(round_ * reg.label_episodes, (round_ + 1) * reg.label_episodes)
-        jobs = [(name, int(seed)) for name in names for seed in seeds[name][chunk]]
+        jobs = [
+            (name, int(seed))
+            for name in names
+            for seed in np.array_split(seeds[name], reg.rounds)[round_]
+        ]
         state = None if model is None else model.state_dict()
         samples = label_round(jobs, state, reg, settings.seed + round_, progress_bar, round_)
         samples.save(run_dir / "labels" / f"round{round_}.npz")
@@ -178,7 +185,8 @@ def _label(task: tuple[str, int, dict[str, Any] | None, RegressionSettings, int]
         return int(candidates.slots[int(torch.argmin(regret[0]))])
 
     base = LinearScorerBase(cfg, weights) if reg.finisher == "frontier-rule" else None
-    return label_episode(cfg, episode, behaviour, base, name, reg.completions, reg.label_every)
+    every = reg.label_every_of(name)
+    return label_episode(cfg, episode, behaviour, base, name, reg.completions, every)
 
 
 def fitted(

@@ -239,6 +239,8 @@ CEM_KEYS = {f.name for f in dataclasses.fields(CEMSettings)}
 FINISHERS = ("nearest-path", "frontier-rule")
 #: The step size over a fit of the map scorer: fixed, or a half cosine down to zero.
 SCHEDULES = ("constant", "cosine")
+#: The labelling settings a family may set for itself (``regression.per_family``).
+PER_FAMILY_KEYS = ("label_episodes", "label_every")
 
 
 @dataclass(frozen=True)
@@ -276,6 +278,11 @@ class RegressionSettings:
         fit_schedule: the step size over a fit: ``constant`` (``fit_rate`` throughout) or
             ``cosine`` (from ``fit_rate`` down to zero along a half cosine, so the fit ends
             at rest rather than wherever its last noisy step left it).
+        per_family: a family's own ``label_episodes`` and ``label_every``
+            (:data:`PER_FAMILY_KEYS`), for example
+            ``{"floorplan-96" = {label_episodes = 24, label_every = 8}}``: few, thinned labels
+            where a family's episodes are long; other families take the section's values, and
+            an entry for a family not in ``train.families`` is not used.
     """
 
     rounds: int = 3
@@ -292,8 +299,18 @@ class RegressionSettings:
     label_every: int = 1
     balance_families: bool = False
     fit_schedule: str = "constant"
+    per_family: dict[str, dict[str, int]] = field(default_factory=dict)
+
+    def label_episodes_of(self, family: str) -> int:
+        """The training episodes labelled per round for ``family``."""
+        return self.per_family.get(family, {}).get("label_episodes", self.label_episodes)
+
+    def label_every_of(self, family: str) -> int:
+        """One decision in this many is labelled in ``family``'s episodes."""
+        return self.per_family.get(family, {}).get("label_every", self.label_every)
 
     def __post_init__(self) -> None:
+        self._check_per_family()
         if not isinstance(self.balance_families, bool):
             raise ValueError(
                 f"regression.balance_families must be true or false, got {self.balance_families!r}"
@@ -337,6 +354,28 @@ class RegressionSettings:
         share = self.rule_share
         if isinstance(share, bool) or not isinstance(share, int | float) or not 0 <= share <= 1:
             raise ValueError(f"regression.rule_share must be a number in [0, 1], got {share!r}")
+
+    def _check_per_family(self) -> None:
+        if not isinstance(self.per_family, dict):
+            raise ValueError(
+                "regression.per_family must be a table of family name -> {label_episodes, "
+                f"label_every}}, got {self.per_family!r}"
+            )
+        from frontier_marl.evaluation.benchmark.families import check_families
+
+        check_families(list(self.per_family), "regression.per_family")
+        for name, values in self.per_family.items():
+            where = f"regression.per_family.{name}"
+            if not isinstance(values, dict):
+                raise ValueError(f"{where} must be a table, got {values!r}")
+            unknown = sorted(set(values) - set(PER_FAMILY_KEYS))
+            if unknown:
+                raise ValueError(
+                    f"{where} has unknown keys {unknown}; allowed: {', '.join(PER_FAMILY_KEYS)}"
+                )
+            for key, value in values.items():
+                if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                    raise ValueError(f"{where}.{key} must be an integer >= 1, got {value!r}")
 
 
 REGRESSION_KEYS = {f.name for f in dataclasses.fields(RegressionSettings)}

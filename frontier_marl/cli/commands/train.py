@@ -155,10 +155,14 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
             rollouts = f"on {reg.completions} completions of the belief, {rollouts}"
         if reg.label_every > 1:
             rollouts = f"{rollouts}; one decision in {reg.label_every} labelled"
+        own = "; ".join(
+            f"{name}: {reg.label_episodes_of(name)}, one decision in {reg.label_every_of(name)}"
+            for name in reg.per_family
+        )
         budget = (
             f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "
-            f"episodes per family (rollouts {rollouts}), {reg.fit_epochs} epochs each, "
-            f"seed {settings.seed}"
+            f"episodes per family{f' ({own})' if own else ''} (rollouts {rollouts}), "
+            f"{reg.fit_epochs} epochs each, seed {settings.seed}"
         )
     if settings.algorithm == "cem":
         cem = CEMSettings(**experiment.cem)
