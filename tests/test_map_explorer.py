@@ -275,6 +275,12 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
         (held_out,) = variant["held_out_decisions"].values()  # round 1's random-20 decisions
         assert held_out["decisions"] > 0 and "frontier-rule" in held_out["choosers"]
         assert set(variant["validation"]["0.0"]["by_family"]) == {"random-20"}
+    ablation_args[ablation_args.index("--train-rounds") + 1] = "2"  # every round
+    ablation_args[ablation_args.index("--variants") + 1] = "no-map"
+    assert ablation_main([str(out), *ablation_args]) == 0
+    ablation = json.loads(ablation_json.read_text())
+    assert ablation["train_labels"] == records[1]["labels"]
+    assert ablation["variants"]["no-map"]["held_out_decisions"] == {}
     ensemble_json = tmp_path / "ensemble.json"
     ensemble_args = ["--sizes", "1,2", "--weights", "0,1", "--episodes", "1", "--epochs", "1"]
     ensemble_args += ["--with", str(out), "--set", "balance_families=true"]

@@ -3,7 +3,9 @@ validation seeds (docs/experiments/2026-12-04-map-aware-explorer.md).
 
 A cost-regression run (``frontier-marl train explorer-map``) keeps each round's labels in
 ``RUN/labels/``. This fits one scorer per variant on every round but the last (or the first
-``--train-rounds``: a learning curve), with the run's fit settings (``[regression]``):
+``--train-rounds``: a learning curve; a one-round run, or ``--train-rounds`` set to all of
+them, fits every round and has no held-out decisions), with the run's fit settings
+(``[regression]``):
 
 * ``full``: the shipped fit, squared error on each candidate's relative regret, reading the
   map crops and the slot features;
@@ -132,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
         "--train-rounds",
         type=int,
         default=None,
-        help="fit on the first N rounds (default: all but the last)",
+        help="fit on the first N rounds (default: all but the last, or the only one); N = "
+        "all rounds: no held-out decisions, the validation episodes only",
     )
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
@@ -142,17 +145,18 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown variants {unknown}; choose from {', '.join(VARIANTS)}")
     try:
         weights = [float(w) for w in args.weights.split(",")]
-        rounds = run_labels(args.run)
+        rounds = run_labels(args.run, minimum=1)
         experiment = run_experiment(args.run)
     except (ValueError, OSError, KeyError) as exc:
         parser.error(str(exc))
     reg = RegressionSettings(**experiment.regression)
     if args.epochs is not None:
         reg = RegressionSettings(**{**experiment.regression, "fit_epochs": args.epochs})
-    fitted_rounds = len(rounds) - 1 if args.train_rounds is None else args.train_rounds
-    if not 1 <= fitted_rounds < len(rounds):
-        parser.error(f"--train-rounds must be in [1, {len(rounds) - 1}], got {fitted_rounds}")
-    train, test = Samples.join(rounds[:fitted_rounds]), rounds[-1]
+    fitted_rounds = max(len(rounds) - 1, 1) if args.train_rounds is None else args.train_rounds
+    if not 1 <= fitted_rounds <= len(rounds):
+        parser.error(f"--train-rounds must be in [1, {len(rounds)}], got {fitted_rounds}")
+    train = Samples.join(rounds[:fitted_rounds])
+    test = rounds[-1] if fitted_rounds < len(rounds) else None  # None: no held-out decisions
     validation = Validation(list(experiment.train.families), args.episodes)
     report: dict[str, Any] = {
         "run": str(args.run),
@@ -163,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     for name in variants:
         model = fit_variant(name, train, reg, experiment.train.seed)
-        decisions = held_out_report(model, test, weights)
+        decisions = {} if test is None else held_out_report(model, test, weights)
         episodes = {str(w): validation(model, w) for w in weights}
         report["variants"][name] = {"held_out_decisions": decisions, "validation": episodes}
         _print_variant(name, decisions, episodes)
