@@ -80,12 +80,8 @@ def train_cost_regression(
     started, cpu_started = time.perf_counter(), time.process_time()
     rng = np.random.default_rng(settings.seed)
     names = list(settings.families)
-    seeds = {
-        name: rng.permutation(np.asarray(family(name).train))[
-            : reg.rounds * reg.label_episodes_of(name)
-        ]
-        for name in names
-    }
+    count = {name: reg.rounds * reg.label_episodes_of(name) for name in names}
+    seeds = {name: rng.permutation(np.asarray(family(name).train))[: count[name]] for name in names}
     validation = Validation(names, settings.validation_episodes)
     labels, model, best = [], None, -np.inf
     (run_dir / "labels").mkdir(parents=True, exist_ok=True)
