@@ -206,6 +206,8 @@ def test_one_decision_in_three_labelled_is_every_third_of_the_full_labels(
     np.testing.assert_array_equal(thinned.decision, labelled.decision[kept] // 3)
     np.testing.assert_array_equal(thinned.cost, labelled.cost[kept])
     np.testing.assert_array_equal(thinned.crops, labelled.crops[kept])
+    with pytest.raises(ValueError, match="every must be an integer >= 1, got 0"):
+        label_episode(cfg, fam.train[0], nearest, every=0)
 
 
 def test_samples_survive_a_round_trip_and_a_join(labelled: Samples, tmp_path: Path) -> None:

@@ -36,6 +36,7 @@ from frontier_marl.policies.lookahead import completion_costs, completion_draws,
 from frontier_marl.policies.map_crops import crop_shape, slot_crops
 from frontier_marl.sim.episodes import EpisodeSource
 from frontier_marl.sim.rollouts import RolloutBase
+from frontier_marl.utils.checks import check_int
 
 #: A behaviour: (observation, the decision's candidate inputs) -> the valid slot it takes.
 Behaviour = Callable[[dict[str, np.ndarray], "Candidates"], int]
@@ -110,8 +111,7 @@ def label_episode(
     belief (no true map; nearest-path finishing)."""
     if completions and base is not None:
         raise ValueError("map completions are finished by nearest-path: pass no base")
-    if every < 1:
-        raise ValueError(f"every must be an integer >= 1, got {every!r}")
+    check_int("every", every, 1)
     source = EpisodeSource(cfg) if completions else None
     env = FrontierParallelEnv(config=cfg)
     rows: list[tuple[Candidates, np.ndarray]] = []

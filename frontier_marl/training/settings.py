@@ -6,6 +6,8 @@ import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from frontier_marl.utils.checks import check_int
+
 EVAL_MAP_MODES = ("as-trained", "static", "dynamic")
 VEC_ENVS = ("batched", "supersuit")
 POLICIES = ("auto", "slot-scorer")
@@ -343,11 +345,9 @@ class RegressionSettings:
             raise ValueError(
                 f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
             )
-        integers = ("rounds", "label_episodes", "label_every", "label_workers", "fit_epochs")
-        for name in (*integers, "fit_batch", "scorer_width"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"regression.{name} must be an integer >= 1, got {value!r}")
+        counts = ("rounds", "label_episodes", "label_every", "label_workers", "fit_epochs")
+        for name in (*counts, "fit_batch", "scorer_width"):
+            check_int(f"regression.{name}", getattr(self, name), 1)
         rate = self.fit_rate
         if isinstance(rate, bool) or not isinstance(rate, int | float) or not rate > 0:
             raise ValueError(f"regression.fit_rate must be a number > 0, got {rate!r}")
@@ -374,8 +374,7 @@ class RegressionSettings:
                     f"{where} has unknown keys {unknown}; allowed: {', '.join(PER_FAMILY_KEYS)}"
                 )
             for key, value in values.items():
-                if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                    raise ValueError(f"{where}.{key} must be an integer >= 1, got {value!r}")
+                check_int(f"{where}.{key}", value, 1)
 
 
 REGRESSION_KEYS = {f.name for f in dataclasses.fields(RegressionSettings)}
