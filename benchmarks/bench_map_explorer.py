@@ -1,6 +1,6 @@
 """Inference speed of the map-aware explorer: decisions per second on one core.
 
-    python benchmarks/bench_map_explorer.py --model runs/explorer-map/best --json out.json
+    python benchmarks/bench_map_explorer.py --model runs/explorer/best --json out.json
 
 What it times: :mod:`frontier_marl.experiments.speed.bench_map_explorer`.
 """

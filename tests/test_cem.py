@@ -128,7 +128,7 @@ def test_train_with_cem_writes_a_model_the_benchmark_runs(tmp_path: Path) -> Non
     run_dir = tmp_path / "cem"
     tiny = ["cem.generations=2", "cem.population=3", "cem.elite=2", "cem.episodes=1"]
     tiny += ["train.validation_episodes=1"]
-    argv = ["train", "explorer", "--out", str(run_dir), "--no-progress"]
+    argv = ["train", "explorer-cem", "--out", str(run_dir), "--no-progress"]
     assert main([*argv, *(arg for s in tiny for arg in ("--set", s))]) == 0
     records = [json.loads(line) for line in (run_dir / "cem.jsonl").read_text().splitlines()]
     assert [r["generation"] for r in records] == [0, 1]
@@ -152,7 +152,7 @@ def test_the_ablation_script_scores_every_part_on_validation_episodes(tmp_path: 
     rows = json.loads(out.read_text())["rows"]
     policies = {row["policy"] for row in rows}
     expected = {"nearest-path", "path-only", "tour-rule", "near-rule", "fill-rule", "explorer-dqn"}
-    assert policies == expected | {"explorer"}
+    assert policies == expected | {"frontier-rule"}
     assert all(row["seeds"][0] == 800_000 for row in rows)
     tour_rule = json.loads((tmp_path / "models" / "tour-rule" / "model.json").read_text())
     assert tour_rule["weights"]["tour"] == -0.5 and tour_rule["weights"]["path"] == -1.0
@@ -164,7 +164,7 @@ def test_the_selection_script_uses_validation_seeds_no_training_run_used(tmp_pat
     argv = ["--episodes", "1", "--heuristics", "nearest-path,cost-utility", "--json", str(out)]
     assert selection.main([*argv, "--no-progress"]) == 0
     rows = json.loads(out.read_text())["rows"]
-    assert {row["policy"] for row in rows} == {"nearest-path", "cost-utility", "explorer"}
+    assert {row["policy"] for row in rows} == {"nearest-path", "cost-utility", "frontier-rule"}
     assert all(row["seeds"] == [800_100] for row in rows)
     for bad in (["--first", "900000"], ["--heuristics", ""]):  # a held-out seed; no heuristic
         with pytest.raises(SystemExit):
@@ -188,7 +188,7 @@ def test_the_tour_sweep_scores_hand_set_rules_on_training_seeds(tmp_path: Path) 
 
 def test_hand_set_weights_must_name_features(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="unknown feature"):
-        save_hand_set({"path": -1.0, "tuor": -0.5}, tmp_path, load_experiment("explorer"))
+        save_hand_set({"path": -1.0, "tuor": -0.5}, tmp_path, load_experiment("explorer-cem"))
 
 
 @pytest.mark.slow
@@ -197,10 +197,10 @@ def test_the_near_probe_scores_what_the_env_feature_would(tmp_path: Path) -> Non
     from frontier_marl.sim.features import NEAR
     from frontier_marl.training.cem import play_scorer
 
-    cfg = load_experiment("explorer", ["env.unknown_near=false"]).env_configs()[2]  # rooms-32
+    cfg = load_experiment("explorer-cem", ["env.unknown_near=false"]).env_configs()[2]  # rooms-32
     seeds = [5, 6, 7]
     t99, _ = play_scorer(cfg, seeds, near_probe.scorer(feature_names(cfg), NEAR, -0.5))
-    featured = load_experiment("explorer", ["env.unknown_near=true"]).env_configs()[2]
+    featured = load_experiment("explorer-cem", ["env.unknown_near=true"]).env_configs()[2]
     rule = {"path": -1.0, "tour": -0.5, "unknown_near": -0.5}
     expected, _ = play_t99(featured, seeds, weight_vector(rule, feature_names(featured), "rule"))
     assert np.array_equal(t99, expected, equal_nan=True)
@@ -248,7 +248,7 @@ def test_the_weight_sensitivity_scales_the_named_weights_on_training_seeds(tmp_p
 def test_the_true_gain_probe_reveals_no_more_than_the_belief_leaves_unknown(tmp_path: Path) -> None:
     from frontier_marl.training.cem import play_scorer
 
-    cfg = load_experiment("explorer").env_configs()[2]  # rooms-32
+    cfg = load_experiment("explorer-cem").env_configs()[2]  # rooms-32
     checked = []
 
     def score(observations: dict, env) -> np.ndarray:

@@ -4,6 +4,7 @@ classic mask layout, ``TypeError`` for unknown keywords, ``max_cycles``, the v1 
 from __future__ import annotations
 
 import numbers
+from pathlib import Path
 from typing import Any
 
 import gymnasium
@@ -23,6 +24,8 @@ LEVEL_KEYS = {
     "full": {"slots", "target", "position", "padding", "oscillation"},
     "debug": {"path"},
 }
+
+EXPLORER_DQN = Path(__file__).resolve().parents[1] / "training" / "models" / "explorer-dqn"
 
 
 def _signature(value: Any) -> tuple[str, tuple[int, ...]]:
@@ -165,7 +168,7 @@ def test_a_model_acts_alike_on_the_classic_and_the_flat_layout() -> None:
     from frontier_marl.policies import ModelPolicy
     from frontier_marl.policies.models import load_model
 
-    loaded = load_model("explorer")
+    loaded = load_model(EXPLORER_DQN)  # a slot scorer of the repository's research models
     cfg = loaded.env_config()
     results = [
         evaluate({"config": cfg, "obs_layout": layout}, ModelPolicy(loaded.model), episodes=2)

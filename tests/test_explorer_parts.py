@@ -489,10 +489,11 @@ def test_the_shipped_explorer_acts_on_every_family_and_a_floor_plan_size(tmp_pat
     import json
 
     from frontier_marl.cli.main import main
+    from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
     from frontier_marl.policies.models import pretrained_model_dir
 
     meta = json.loads((pretrained_model_dir("explorer") / "model.json").read_text())
-    assert meta["observation_layout"]["features"] == "explorer"
+    assert meta["format"] == "map-scorer" and meta["env_settings"] == FRONTIER_RULE_SETTINGS
     out = tmp_path / "bench.json"
     argv = ["benchmark", "--policies", "explorer", "--episodes", "1", "--split", "validation"]
     argv += ["--families", "random-20,random-30,rooms-32,rooms-64"]

@@ -47,8 +47,9 @@ def test_the_rule_needs_its_layout_and_its_env() -> None:
 
 
 def test_the_rule_decides_as_the_linear_model_with_its_weights_did() -> None:
-    """The linear ``explorer`` model (a MaskedDQN whose scorer held these weights) and the rule
-    play the same episodes to the same cell counts."""
+    """A linear slot model (a MaskedDQN whose scorer holds these weights, as the linear
+    ``explorer`` did until the map-aware model replaced it) and the rule play the same episodes
+    to the same cell counts."""
     pytest.importorskip("stable_baselines3")
     from frontier_marl.policies.base import ModelPolicy
     from frontier_marl.policies.linear_scorer import weight_vector

@@ -118,12 +118,13 @@ def test_imitation_labels_real_decisions_and_fits_them() -> None:
 
 def test_a_linear_rollout_base_takes_the_best_scored_live_slot() -> None:
     from frontier_marl import FrontierParallelEnv
+    from frontier_marl.config import make_config
     from frontier_marl.core.slots import SlotArrays
+    from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
     from frontier_marl.policies.linear_scorer import feature_names
     from frontier_marl.policies.lookahead import LinearScorerBase
-    from frontier_marl.policies.models import load_model
 
-    cfg = load_model("explorer").env_config()
+    cfg = make_config("thesis-20x20", map_mode="dynamic", **FRONTIER_RULE_SETTINGS)
     path_only = np.array([-1.0 if name == "path" else 0.0 for name in feature_names(cfg)])
     base = LinearScorerBase(cfg, path_only)  # nearest-path among the 12 slots
     env = FrontierParallelEnv(config=cfg)
@@ -155,7 +156,7 @@ def test_the_rollout_probe_scores_both_oracles_on_validation_episodes(tmp_path) 
     )
     rows = json.loads(out.read_text())["rows"]
     assert [row["policy"] for row in rows] == [
-        "nearest-path", "explorer", "lookahead-oracle", "explorer-rollout"
+        "nearest-path", "frontier-rule", "lookahead-oracle", "explorer-rollout"
     ]  # fmt: skip
     assert all(row["seeds"] == [800_000, 800_001] and row["success"] == 2 for row in rows)
     with pytest.raises(SystemExit):

@@ -230,7 +230,7 @@ def test_a_fit_depends_on_its_seed_alone(labelled: Samples) -> None:
 
 
 @pytest.mark.slow
-def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path) -> None:
+def test_train_explorer_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
     tiny = {
         "train.families": '["random-20"]',
@@ -242,7 +242,9 @@ def test_train_explorer_map_writes_a_scorer_that_the_benchmark_runs(tmp_path: Pa
         "regression.completions": 2,
     }
     sets = [arg for key, value in tiny.items() for arg in ("--set", f"{key}={value}")]
-    assert main(["train", "explorer-map", "--out", str(out), "--no-progress", *sets]) == 0
+    assert main(["train", "explorer", "--out", str(out), "--no-progress", *sets]) == 0
+    started = capsys.readouterr().out
+    assert "1 labelled training episodes per family (rollouts" in started  # no other family's
     records = [json.loads(line) for line in (out / "validation.jsonl").read_text().splitlines()]
     assert [r["round"] for r in records] == [0, 1] and records[1]["labels"] > records[0]["labels"]
     tried = records[0]["by_rule_weight_and_family"]
@@ -340,7 +342,7 @@ def test_the_step_size_schedules_have_their_known_values() -> None:
     with pytest.raises(ValueError, match="unknown schedule 'linear'"):
         fit(new_scorer(14, 8), None, 1, schedule="linear")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="regression.fit_schedule must be one of constant, cos"):
-        load_experiment("explorer-map", ['regression.fit_schedule="linear"'])
+        load_experiment("explorer", ['regression.fit_schedule="linear"'])
 
 
 def test_a_weighted_fit_draws_only_decisions_of_positive_weight(labelled: Samples) -> None:
@@ -397,6 +399,37 @@ def test_the_explorer_acts_on_valid_slots_only() -> None:
     assert choices > 5  # it chose among several slots, not only forced steps
 
 
+def test_a_map_scorer_refuses_a_team() -> None:
+    world = make_config("thesis-20x20", n_agents=2)
+    env = frontier_marl.parallel_env(config=scorer_config(world))
+    with pytest.raises(ValueError, match="decides for one robot; the env has n_agents=2"):
+        MapExplorer(new_scorer(14, 8)).attach(env)
+
+
+def test_evaluate_plays_the_shipped_explorer_beside_a_heuristic(tmp_path: Path, capsys) -> None:
+    """`frontier-marl evaluate explorer`: the thesis protocol on the world of --preset, in
+    frontier-rule's observation, the same episodes for the heuristic; bad input named."""
+    out = tmp_path / "eval.json"
+    argv = ["evaluate", "explorer", "--episodes", "2", "--preset", "rooms-32", "--jobs", "1"]
+    argv += ["--set", "no_progress_limit=1024"]  # the preset's 20 cuts long trips short
+    assert main([*argv, "--json", str(out), "--no-progress"]) == 0
+    result = json.loads(out.read_text())
+    assert result["kind"] == "map-scorer" and result["labels"] > 0
+    assert [row["policy"] for row in result["rows"]] == ["model", "greedy-distance"]
+    assert result["env_config"]["height"] == 32 and result["env_config"]["n_slots"] == 12
+    assert result["env_config"]["map_mode"] == "dynamic"  # as trained
+    assert result["model"]["terminations"] == 2
+    assert "map scorer, " in capsys.readouterr().out
+    for bad, message in (
+        (["--set", "n_slots=8"], "so n_slots cannot be set"),
+        (["--agents", "2"], "decides for one robot"),
+    ):
+        assert main(["evaluate", "explorer", "--episodes", "1", *bad]) == 2
+        assert message in capsys.readouterr().err
+    assert main(["evaluate", "explorer-map", "--episodes", "1"]) == 2
+    assert "'explorer-map' is now called 'explorer'" in capsys.readouterr().err
+
+
 def test_labels_over_map_completions_are_other_costs_of_the_same_decisions() -> None:
     fam = map_families.family("random-20")
     episode = ("random-20", int(fam.train[0]), None)
@@ -413,23 +446,23 @@ def test_labels_over_map_completions_are_other_costs_of_the_same_decisions() -> 
 
 def test_a_bad_regression_section_is_named() -> None:
     with pytest.raises(ValueError, match=r"regression.rounds must be an integer >= 1"):
-        load_experiment("explorer-map", ["regression.rounds=0"])
+        load_experiment("explorer", ["regression.rounds=0"])
     with pytest.raises(ValueError, match=r"unknown \[regression\] key"):
-        load_experiment("explorer-map", ["regression.epochs=3"])
+        load_experiment("explorer", ["regression.epochs=3"])
     with pytest.raises(ValueError, match="regression.finisher must be one of nearest-path, "):
-        load_experiment("explorer-map", ['regression.finisher="greedy-gain"'])
+        load_experiment("explorer", ['regression.finisher="greedy-gain"'])
     with pytest.raises(ValueError, match="regression.completions must be an integer >= 0"):
-        load_experiment("explorer-map", ["regression.completions=-1"])
+        load_experiment("explorer", ["regression.completions=-1"])
     with pytest.raises(ValueError, match="regression.completions needs regression.finisher"):
         load_experiment(
-            "explorer-map", ["regression.completions=4", 'regression.finisher="frontier-rule"']
+            "explorer", ["regression.completions=4", 'regression.finisher="frontier-rule"']
         )
     with pytest.raises(ValueError, match="needs train.families and one robot"):
-        load_experiment("explorer-map", ["train.families=[]"])
+        load_experiment("explorer", ["train.families=[]"])
     with pytest.raises(ValueError, match=r"regression.label_every must be an integer >= 1"):
-        load_experiment("explorer-map", ["regression.label_every=0"])
+        load_experiment("explorer", ["regression.label_every=0"])
     with pytest.raises(ValueError, match="regression.balance_families must be true or false"):
-        load_experiment("explorer-map", ["regression.balance_families=1"])
+        load_experiment("explorer", ["regression.balance_families=1"])
 
 
 def test_a_family_may_label_its_own_episodes_and_decisions() -> None:
@@ -437,25 +470,25 @@ def test_a_family_may_label_its_own_episodes_and_decisions() -> None:
     reg = cost_regression.RegressionSettings(label_episodes=5, label_every=2, per_family=own)
     assert (reg.label_episodes_of("floorplan-96"), reg.label_every_of("floorplan-96")) == (3, 8)
     assert (reg.label_episodes_of("rooms-32"), reg.label_every_of("rooms-32")) == (5, 2)
-    shipped = cost_regression.RegressionSettings(**load_experiment("explorer-map").regression)
+    shipped = cost_regression.RegressionSettings(**load_experiment("explorer").regression)
     assert shipped.label_every_of("floorplan-96") > 1 == shipped.label_every_of("random-20")
 
 
 def test_a_bad_per_family_entry_is_named() -> None:
     with pytest.raises(ValueError, match=r"regression.per_family: unknown family 'floorplan96'"):
-        load_experiment("explorer-map", ["regression.per_family={floorplan96={label_every=2}}"])
+        load_experiment("explorer", ["regression.per_family={floorplan96={label_every=2}}"])
     with pytest.raises(ValueError, match=r"per_family.rooms-32 has unknown keys \['epochs'\]"):
-        load_experiment("explorer-map", ["regression.per_family={rooms-32={epochs=2}}"])
+        load_experiment("explorer", ["regression.per_family={rooms-32={epochs=2}}"])
     with pytest.raises(ValueError, match=r"per_family.rooms-32.label_every must be an integer"):
-        load_experiment("explorer-map", ["regression.per_family={rooms-32={label_every=0}}"])
+        load_experiment("explorer", ["regression.per_family={rooms-32={label_every=0}}"])
     with pytest.raises(ValueError, match=r"regression.per_family.rooms-32 must be a table"):
-        load_experiment("explorer-map", ["regression.per_family={rooms-32=4}"])
+        load_experiment("explorer", ["regression.per_family={rooms-32=4}"])
 
 
-def test_the_shipped_explorer_map_is_the_committed_configs_scorer() -> None:
-    model, meta = load_scorer("explorer-map")
+def test_the_shipped_explorer_is_the_committed_configs_scorer() -> None:
+    model, meta = load_scorer("explorer")
     assert meta["format"] == "map-scorer" and meta["rule_weight"] == 0.5
-    committed = load_experiment("explorer-map").to_dict()
+    committed = load_experiment("explorer").to_dict()
     assert {k: meta["experiment"][k] for k in ("train", "regression")} == {
         k: committed[k] for k in ("train", "regression")
     }

@@ -26,6 +26,7 @@ from tests.helpers import silent
 
 #: The MaskablePPO research model of the explorer studies (in the repository, not the wheel)
 EXPLORER_PPO = Path(__file__).resolve().parents[1] / "training" / "models" / "explorer-ppo"
+EXPLORER_DQN = EXPLORER_PPO.parent / "explorer-dqn"
 
 EXPLORER = {"features": "explorer", "n_slots": 6, "gain": "unknown", "reward": "travel"}
 CLASSES = [(PPO, SlotActorCriticPolicy), (MaskablePPO, MaskableSlotActorCriticPolicy)]
@@ -238,7 +239,7 @@ def test_the_explorer_ppo_research_model_loads_and_explores(tmp_path: Path) -> N
     assert row["policy"] == "explorer-ppo" and row["success"] == row["episodes"] == 2
 
 
-@pytest.mark.parametrize("name", ["explorer", str(EXPLORER_PPO)])
+@pytest.mark.parametrize("name", [str(EXPLORER_DQN), str(EXPLORER_PPO)])
 def test_skipping_forced_steps_leaves_the_slot_scorers_episodes_unchanged(name: str) -> None:
     """A slot scorer is not asked when one slot is valid; it would have taken that slot."""
     from frontier_marl.envs.parallel import FrontierParallelEnv

@@ -180,7 +180,7 @@ def test_a_core_only_install_runs_the_heuristics_the_benchmark_and_the_renderer(
         "--out", "episode.gif", cwd=tmp_path,
     )  # fmt: skip
     assert (tmp_path / "episode.gif").stat().st_size > 0
-    shipped = ("explorer", "explorer-map")  # an SB3 zip and a map scorer (torch)
+    shipped = ("explorer", "team-explorer")  # a map scorer (torch) and an SB3 zip
     for args in (["evaluate", "explorer"], *(["benchmark", "--policies", m] for m in shipped)):
         out = run(core_only, command, *args, "--no-progress", cwd=tmp_path, expect=2)
         message = [line for line in out.splitlines() if line.strip()]

@@ -1,8 +1,10 @@
 """Evaluation of a trained model with the thesis protocol, beside a heuristic.
 
 The episodes are run by :func:`frontier_marl.evaluation.evaluate` (one protocol for models and
-heuristics); the SB3 model acts through :class:`frontier_marl.evaluation.ModelPolicy` with
-``deterministic=True`` (epsilon = 0). Before any episode the model is checked against the env
+heuristics); an SB3 model acts through :class:`frontier_marl.evaluation.ModelPolicy` with
+``deterministic=True`` (epsilon = 0), a map-aware scorer (``explorer``) through its
+:class:`~frontier_marl.policies.map_explorer.MapExplorer` (:func:`evaluate_map_scorer`). Before
+any episode an SB3 model is checked against the env
 (:func:`~frontier_marl.policies.metadata.check_compatible`). Each episode is a task of its own
 (:class:`EvaluationTask`), so the episodes can run in worker processes or on a Ray cluster.
 """
@@ -11,13 +13,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
-from frontier_marl.evaluation.model_refs import ModelRef, source_of
+from frontier_marl.evaluation.benchmark.contenders import own_world
+from frontier_marl.evaluation.model_refs import ModelRef, ScorerMaker, cached_scorer, source_of
 from frontier_marl.evaluation.protocol import evaluate
 from frontier_marl.evaluation.records import EvaluationResult
-from frontier_marl.policies import ModelPolicy, make_policy
+from frontier_marl.policies import ModelPolicy, Policy, make_policy
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_SETTINGS
 from frontier_marl.policies.metadata import env_config_from_metadata
 from frontier_marl.policies.models import LoadedModel, check_model_env
 from frontier_marl.utils.parallel import map_tasks
@@ -45,12 +50,24 @@ def degeneracy(shares: Sequence[float], threshold: float = DEGENERACY_THRESHOLD)
 
 
 @dataclass(frozen=True)
+class SB3PolicyMaker:
+    """A picklable factory of the saved SB3 model ``ref``'s deterministic policy."""
+
+    ref: ModelRef
+    label: str
+
+    def __call__(self) -> Policy:
+        return ModelPolicy(self.ref.get().model, name=self.label, deterministic=True)
+
+
+@dataclass(frozen=True)
 class EvaluationTask:
-    """One episode of :func:`evaluate_model`, the unit of work: the model (``model`` set) or
-    the heuristic ``policy`` (seeded with ``policy_seed``) from reset seed ``seed``."""
+    """One episode of :func:`evaluate_model`, the unit of work: the model (``make`` set: a
+    picklable factory of its policy) or the heuristic ``policy`` (seeded with
+    ``policy_seed``) from reset seed ``seed``."""
 
     policy: str
-    model: ModelRef | None
+    make: Callable[[], Policy] | None
     config: EnvConfig
     seed: int
     policy_seed: int
@@ -61,10 +78,7 @@ class EvaluationTask:
 
 def play_evaluation_episode(task: EvaluationTask) -> EvaluationResult:
     """The protocol on one episode (wherever it runs, the same result)."""
-    if task.model is not None:
-        policy = ModelPolicy(task.model.get().model, name=task.policy, deterministic=True)
-    else:
-        policy = make_policy(task.policy, task.policy_seed)
+    policy = task.make() if task.make is not None else make_policy(task.policy, task.policy_seed)
     return evaluate({"config": task.config}, policy, episodes=1, seed=task.seed)
 
 
@@ -80,19 +94,66 @@ def evaluate_model(
     ray_address: str | None = None,
     progress: bool = False,
 ) -> dict[str, Any]:
-    """The model and each heuristic on the same episodes (seeds ``seed .. seed+episodes-1``),
-    in ``jobs`` processes (``None``: every core) or on the Ray cluster at ``ray_address``
-    (:func:`~frontier_marl.utils.parallel.map_tasks`; the same result either way).
+    """The SB3 model and each heuristic on the same episodes (seeds ``seed ..
+    seed+episodes-1``), in ``jobs`` processes (``None``: every core) or on the Ray cluster at
+    ``ray_address`` (:func:`~frontier_marl.utils.parallel.map_tasks`; the same result either
+    way).
 
     Returns a JSON-able dict: ``model`` (the model's row with ``degeneracy``), ``heuristics``
     (one row per heuristic), ``rows`` (all rows, model first), the env config and the model
     file. Rows are :meth:`EvaluationResult.to_dict` outputs (per-episode curves included).
     """
     check_model_env(loaded, cfg)
-    ref = ModelRef(source_of(loaded.path), loaded)
+    make = SB3PolicyMaker(ModelRef(source_of(loaded.path), loaded), name)
+    meta = loaded.metadata or {}
+    steps = int(getattr(loaded.model, "num_timesteps", meta.get("num_timesteps", 0)))
+    result = _beside_heuristics(
+        make, name, cfg, episodes, seed, heuristics, on_episode, jobs, ray_address, progress
+    )
+    return {"model_path": str(loaded.path), "kind": "sb3", "num_timesteps": steps, **result}
+
+
+def evaluate_map_scorer(
+    folder: Path,
+    cfg: EnvConfig,
+    episodes: int = 30,
+    seed: int = 0,
+    heuristics: Sequence[str] = ("greedy-distance",),
+    name: str = "model",
+    jobs: int | None = 1,
+    ray_address: str | None = None,
+    progress: bool = False,
+) -> dict[str, Any]:
+    """:func:`evaluate_model` for a saved map-aware scorer (:mod:`frontier_marl.policies.
+    map_explorer`, in ``folder``) on ``cfg`` (:func:`map_scorer_env_config`); the result
+    records how many labelled candidates it was fitted on (``labels``) instead of steps."""
+    source = str(Path(folder).resolve())
+    _, metadata = cached_scorer(source)  # fails here (e.g. no torch), not in an episode
+    result = _beside_heuristics(
+        ScorerMaker(source, name), name, cfg, episodes, seed, heuristics, None, jobs,
+        ray_address, progress,
+    )  # fmt: skip
+    labels = int(metadata.get("labels", 0))
+    return {"model_path": source, "kind": "map-scorer", "labels": labels, **result}
+
+
+def _beside_heuristics(
+    make: Callable[[], Policy],
+    name: str,
+    cfg: EnvConfig,
+    episodes: int,
+    seed: int,
+    heuristics: Sequence[str],
+    on_episode: Callable[[str, int], None] | None,
+    jobs: int | None,
+    ray_address: str | None,
+    progress: bool,
+) -> dict[str, Any]:
+    """The protocol's rows for the policy ``make`` builds and for each heuristic, on the same
+    episodes (the part of the result shared by every kind of model)."""
     labels = [name, *heuristics]
     tasks = [
-        EvaluationTask(label, ref if i == 0 else None, cfg, seed + k, seed)
+        EvaluationTask(label, make if i == 0 else None, cfg, seed + k, seed)
         for i, label in enumerate(labels)
         for k in range(episodes)
     ]
@@ -116,10 +177,7 @@ def evaluate_model(
         row = replace(part[0], episodes=[r.episodes[0] for r in part]).to_dict()
         row["degeneracy"] = degeneracy(row["action_shares"])
         rows.append(row)
-    meta = loaded.metadata or {}
     return {
-        "model_path": str(loaded.path),
-        "num_timesteps": int(getattr(loaded.model, "num_timesteps", meta.get("num_timesteps", 0))),
         "deterministic": True,
         "episodes": episodes,
         "seed": seed,
@@ -157,6 +215,32 @@ def evaluation_env_config(
             "--set normalize=true)"
         )
     return make_config(preset or "thesis-20x20", **overrides)
+
+
+def map_scorer_env_config(
+    preset: str | None = None, overrides: dict[str, Any] | None = None
+) -> EnvConfig:
+    """The env to evaluate a map-aware scorer on: the world of ``preset`` (default
+    ``thesis-20x20``) with ``overrides``, observed as frontier-rule observes it (the scorer
+    chooses among frontier-rule's slots). ValueError for an override of an observation setting
+    the scorer reads, rather than dropping it."""
+    overrides = dict(overrides or {})
+    fixed = sorted(
+        key for key, value in overrides.items()
+        if key in FRONTIER_RULE_SETTINGS and value != FRONTIER_RULE_SETTINGS[key]
+    )  # fmt: skip
+    if fixed:
+        raise ValueError(
+            f"a map scorer reads frontier-rule's observation, so {', '.join(fixed)} cannot be "
+            f"set (it is {', '.join(repr(FRONTIER_RULE_SETTINGS[k]) for k in fixed)})"
+        )
+    world = make_config(preset or "thesis-20x20", **overrides)
+    if world.n_agents != 1:
+        raise ValueError(
+            f"a map scorer decides for one robot, got n_agents={world.n_agents} (a map-aware "
+            "team scorer is not built yet)"
+        )
+    return own_world(FRONTIER_RULE_SETTINGS, world)
 
 
 def format_comparison(result: dict[str, Any]) -> str:

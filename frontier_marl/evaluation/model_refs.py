@@ -74,3 +74,19 @@ class ModelRef:
 
     def get(self) -> LoadedModel:
         return self.loaded if self.loaded is not None else cached_model(self.source)
+
+
+@dataclass(frozen=True)
+class ScorerMaker:
+    """A picklable factory of the map scorer saved in ``folder``: a
+    :class:`~frontier_marl.policies.map_explorer.MapExplorer` labelled ``label``, with the
+    weight of frontier-rule's margin its training chose (``rule_weight`` in its metadata)."""
+
+    folder: str
+    label: str
+
+    def __call__(self) -> Any:
+        from frontier_marl.policies.map_explorer import MapExplorer  # torch: cached_scorer's
+
+        model, metadata = cached_scorer(self.folder)
+        return MapExplorer(model, self.label, float(metadata.get("rule_weight", 0.0)))

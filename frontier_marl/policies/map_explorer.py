@@ -48,7 +48,7 @@ def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) 
 
 
 def load_scorer(folder: str | Path) -> tuple[MapScorer, dict[str, Any]]:
-    """The scorer saved in ``folder`` (or shipped under that name, e.g. ``explorer-map``) and
+    """The scorer saved in ``folder`` (or shipped under that name, e.g. ``explorer``) and
     its metadata; ValueError naming a damaged or missing file."""
     folder = map_scorer_folder(folder) or Path(folder)
     try:
@@ -84,6 +84,11 @@ class MapExplorer(Policy):
         return cls(model, name, float(metadata.get("rule_weight", 0.0)))
 
     def attach(self, env: Any) -> None:
+        if env.config.n_agents != 1:
+            raise ValueError(
+                f"{self.name} decides for one robot; the env has n_agents="
+                f"{env.config.n_agents} (a map-aware team scorer is not built yet)"
+            )
         expected = self.model.feature_mean.numel()
         if len(feature_names(env.config)) != expected:
             raise ValueError(

@@ -4,12 +4,11 @@
 
 Each model lives in ``frontier_marl/assets/models/<name>/`` as ``model.zip`` (SB3 DQN) with
 its ``model.json`` metadata (env config, observation layout, training run), or, for the
-map-aware ``explorer-map``, as ``model.pt`` (torch weights,
-:mod:`frontier_marl.policies.map_explorer`) with its ``model.json``. How each was
-trained is in docs/results.md (``thesis-config01``) and docs/beyond-the-thesis.md
-(``explorer``, ``team-explorer``). The research models of the explorer studies
-(``explorer-dqn``, ``explorer-ppo``) are not in the package: they lie in the repository's
-``training/models/`` and load by path.
+map-aware ``explorer``, as ``model.pt`` (torch weights, :mod:`frontier_marl.policies.
+map_explorer`) with its ``model.json``. How each was trained is in docs/results.md
+(``thesis-config01``) and docs/beyond-the-thesis.md (``explorer``, ``team-explorer``). The
+research models of the explorer studies (``explorer-dqn``, ``explorer-ppo``) are not in the
+package: they lie in the repository's ``training/models/`` and load by path.
 """
 
 from __future__ import annotations
@@ -36,34 +35,42 @@ from frontier_marl.policies.model_files import MODEL_FILE, newest_good_checkpoin
 
 #: name -> one-line description
 PRETRAINED: dict[str, str] = {
-    "explorer": "the learned frontier selector (docs/beyond-the-thesis.md): a linear, "
-    "permutation-equivariant slot scorer on size-independent slot features with the tour, "
-    "unknown_near and fill features, trained by the cross-entropy method on T99 on five "
-    "benchmark map families by `frontier-marl train explorer` (seed 0); the best-validated "
-    "weights (generation 0 of 12)",
-    "explorer-map": "the map-aware learned selector (docs/experiments/2026-12-04-map-aware-"
+    "explorer": "the learned frontier selector (docs/experiments/2026-12-04-map-aware-"
     "explorer.md): a small CNN over the belief map around each of frontier-rule's 12 slots, "
     "fitted to each candidate's mean cost-to-go over 16 completions of the belief on six "
-    "families by `frontier-marl train explorer-map` (seed 0, 72 minutes); it overrules "
+    "families by `frontier-marl train explorer` (seed 0, 72 minutes); it overrules "
     "frontier-rule where it predicts a clear gain (the rule's margin weighed 0.5); torch only",
-    "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): the explorer's "
-    "slot scorer with three teammate features per slot, one parameter-shared model for teams "
-    "of 2 to 8, trained on random-30 and rooms-64 by `frontier-marl train team-explorer` "
-    "(seed 0); the best-validated policy (step 1,600,032)",
+    "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): a slot scorer "
+    "on frontier-rule's slot features with three teammate features per slot, one "
+    "parameter-shared model for teams of 2 to 8, trained on random-30 and rooms-64 by "
+    "`frontier-marl train team-explorer` (seed 0); the best-validated policy (step 1,600,032)",
     "thesis-config01": "configuration 1 (absolute centroids + agent position, unsorted, "
     "Reward 2, normalized): the best-validated policy of seed 2 (step 340,000) of a default "
     "frontier-marl reproduce run, the seed whose protocol score is the median of the three",
 }
 
 
+#: Shipped models and configs renamed: old name -> new name (named in the error for the old).
+RENAMED: dict[str, str] = {"explorer-map": "explorer"}
+
+
 def pretrained_names() -> list[str]:
     return list(PRETRAINED)
+
+
+def renamed_hint(name: str) -> str:
+    """`` (NAME is now called NEW)`` for a renamed shipped model, else the empty string."""
+    new = RENAMED.get(str(name))
+    return f" ({name!r} is now called {new!r})" if new else ""
 
 
 def pretrained_model_dir(name: str) -> Path:
     """The folder of shipped model ``name``; ``ValueError`` if unknown or missing."""
     if name not in PRETRAINED:
-        raise ValueError(f"pretrained model must be one of {pretrained_names()}, got {name!r}")
+        raise ValueError(
+            f"pretrained model must be one of {pretrained_names()}, got {name!r}"
+            + renamed_hint(name)
+        )
     folder = resources.files("frontier_marl").joinpath("assets", "models", name)
     files = ("model.zip", MAP_SCORER_FILE)
     if not isinstance(folder, Path) or not any((folder / f).is_file() for f in files):
@@ -147,13 +154,13 @@ def resolve_model_path(path: str | Path) -> Path:
         if map_scorer_folder(path) is not None:
             raise ValueError(
                 f"{str(path)!r} is a map-aware scorer ({MAP_SCORER_FILE}), not an SB3 model: "
-                "play it with `frontier-marl benchmark --policies` or `frontier-marl gif`"
+                "play it with `frontier-marl evaluate`, `benchmark --policies` or `gif`"
             )
         raise ValueError(f"no {MODEL_FILE} in folder {str(path)!r}")
     if not path.is_file() and path.with_suffix(".zip").is_file():
         path = path.with_suffix(".zip")
     if not path.is_file():
-        raise ValueError(f"model file {str(path)!r} not found")
+        raise ValueError(f"model file {str(path)!r} not found" + renamed_hint(str(path)))
     return path
 
 

@@ -36,7 +36,6 @@ from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.benchmark.families import family
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.metadata import build_metadata, save_metadata
-from frontier_marl.policies.models import pretrained_model_dir
 from frontier_marl.policies.networks.slot_dqn import MaskedDQN, SlotDQNPolicy
 from frontier_marl.sim.rewards import THRESHOLD
 from frontier_marl.training.batched_vec_env import make_batched_vec_env
@@ -117,11 +116,6 @@ def changes_text(changes: Mapping[str, Mapping[str, float]]) -> str:
     return "  ".join(
         f"{label} {100 * c['change']:+.2f}±{100 * c['stderr']:.2f}" for label, c in changes.items()
     )
-
-
-def shipped_weights(name: str = "explorer") -> dict[str, float]:
-    """The weights by feature name of the shipped linear scorer ``name``."""
-    return json.loads((pretrained_model_dir(name) / "model.json").read_text())["weights"]
 
 
 def candidate_score(

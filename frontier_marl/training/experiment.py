@@ -40,6 +40,7 @@ from typing import Any
 from frontier_marl.config import EnvConfig, config_keys, make_config
 from frontier_marl.core.example_maps import EXAMPLE_MAPS, example_map_path
 from frontier_marl.evaluation.benchmark.families import family, variant_configs
+from frontier_marl.policies.models import renamed_hint
 from frontier_marl.training.algorithms import SB3_ALGORITHMS
 from frontier_marl.training.dqn import DQN, THESIS_DQN
 from frontier_marl.training.ppo import PPO, with_prior_vector
@@ -321,7 +322,7 @@ def _read_config(config: str | Path) -> tuple[str, str]:
         return resource.read_text(encoding="utf-8"), f"{name} (shipped)"
     raise ValueError(
         f"config {str(config)!r} is neither a file nor a shipped config "
-        f"({', '.join(shipped_configs())})"
+        f"({', '.join(shipped_configs())})" + renamed_hint(name)
     )
 
 

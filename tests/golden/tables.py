@@ -74,8 +74,9 @@ COMMANDS: dict[str, list[str]] = {
 }
 
 
-#: Keys left out of the digest: the resolved env config (new keys may be added) and file paths.
-_UNHASHED = {"config", "env_config", "model_path"}
+#: Keys left out of the digest: the resolved env config (new keys may be added), file paths and
+#: the kind of model evaluated (a label, added 2026-12-07).
+_UNHASHED = {"config", "env_config", "model_path", "kind"}
 
 
 def _strip_config(value: Any) -> Any:

@@ -6,9 +6,12 @@ Examples::
     frontier-marl evaluate runs/config01/seed0/model.zip --map-mode dynamic --episodes 30 \\
         --json eval.json --plot actions.png
     frontier-marl evaluate thesis-config01 --jobs 4          # 4 processes (default: all cores)
+    frontier-marl evaluate explorer --preset rooms-32        # the map-aware explorer
 
 The env is the one the model was trained on (read from the ``model.json`` beside it), changed
-only by ``--map-mode``, ``--preset`` and ``--set``. Reported: mean and std of the total episode
+only by ``--map-mode``, ``--preset`` and ``--set``. A map-aware scorer (``explorer``) was
+trained on several families, so it plays the world of ``--preset`` (default thesis-20x20, fresh
+layouts), observed as frontier-rule observes it. Reported: mean and std of the total episode
 reward, terminations (episodes reaching the exploration threshold), action shares and the
 degeneracy flag (one action in more than 90 % of steps), for the model (deterministic) and
 greedy-distance on the same episodes. A model whose observation layout or spaces do not match
@@ -20,6 +23,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from frontier_marl.cli.arguments import (
     add_parallel_arguments,
@@ -29,14 +33,16 @@ from frontier_marl.cli.arguments import (
     parse_policies,
     positive_int,
 )
-from frontier_marl.config import PRESETS
+from frontier_marl.config import PRESETS, EnvConfig
 from frontier_marl.evaluation.model_evaluation import (
+    evaluate_map_scorer,
     evaluate_model,
     evaluation_env_config,
     format_comparison,
+    map_scorer_env_config,
 )
 from frontier_marl.policies.metadata import ModelEnvMismatchError
-from frontier_marl.policies.models import load_model
+from frontier_marl.policies.models import load_model, map_scorer_folder
 from frontier_marl.utils.set_options import parse_set_options
 
 
@@ -44,8 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "model",
         metavar="MODEL",
-        help="model.zip, a run folder, a checkpoint folder, or a shipped "
-        "model's name (thesis-config01)",
+        help="model.zip, a run folder, a checkpoint folder, a map scorer's folder, or a "
+        "shipped model's name (thesis-config01, explorer)",
     )
     parser.add_argument(
         "--episodes",
@@ -57,7 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--map-mode",
         choices=["static", "dynamic"],
         default=None,
-        help="map mode (default: the one the model was trained on)",
+        help="map mode (default: the one the model was trained on; dynamic for a map scorer)",
     )
     parser.add_argument(
         "--seed",
@@ -69,7 +75,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--preset",
         choices=sorted(PRESETS),
         default=None,
-        help="evaluate on another geometry (default: the training env's)",
+        help="evaluate on another geometry (default: the training env's; thesis-20x20 for a "
+        "map scorer)",
     )
     parser.add_argument(
         "--agents",
@@ -116,6 +123,10 @@ def run(args: argparse.Namespace) -> int:
         if args.agents is not None:
             overrides["n_agents"] = args.agents
         heuristics = parse_policies(args.heuristics) if args.heuristics.strip() else []
+        scorer = map_scorer_folder(args.model)
+        if scorer is not None:
+            check_parallel_arguments(args)
+            return _run_map_scorer(args, scorer, overrides, heuristics)
         loaded = load_model(args.model)
         cfg = evaluation_env_config(loaded, args.preset, overrides)
         check_parallel_arguments(args)
@@ -142,11 +153,40 @@ def run(args: argparse.Namespace) -> int:
         )
     except (ModelEnvMismatchError, ConnectionError) as exc:
         return _fail(str(exc))
+    _report(args, result, f"{loaded.path} ({result['num_timesteps']} training steps)", cfg)
+    return 0
+
+
+def _run_map_scorer(
+    args: argparse.Namespace, folder: Path, overrides: dict[str, Any], heuristics: list[str]
+) -> int:
+    """The protocol for a map-aware scorer on the world of ``--preset``."""
+    overrides.setdefault("map_mode", "dynamic")
+    try:
+        cfg = map_scorer_env_config(args.preset, overrides)
+        result = evaluate_map_scorer(
+            folder,
+            cfg,
+            episodes=args.episodes,
+            seed=args.seed,
+            heuristics=heuristics,
+            jobs=args.jobs,
+            ray_address=args.ray_address,
+            progress=not args.no_progress,
+        )
+    except (ValueError, ConnectionError) as exc:
+        return _fail(str(exc))
+    _report(args, result, f"{folder} (map scorer, {result['labels']:,} labelled candidates)", cfg)
+    return 0
+
+
+def _report(args: argparse.Namespace, result: dict[str, Any], what: str, cfg: EnvConfig) -> None:
+    """Print the comparison; write the JSON and the action histogram if asked."""
     layout = f"map_seed={cfg.map_seed}" if cfg.map_mode == "static" else "fresh layout per seed"
+    last = args.seed + args.episodes - 1
     print(
-        f"{loaded.path} ({result['num_timesteps']} training steps): {cfg.height}x{cfg.width}, "
-        f"r={cfg.perception_range}, {cfg.map_mode} map ({layout}), {args.episodes} episodes, "
-        f"seeds {args.seed}..{args.seed + args.episodes - 1}, deterministic"
+        f"{what}: {cfg.height}x{cfg.width}, r={cfg.perception_range}, {cfg.map_mode} map "
+        f"({layout}), {args.episodes} episodes, seeds {args.seed}..{last}, deterministic"
     )
     print(format_comparison(result))
     if args.json is not None:
@@ -158,6 +198,6 @@ def run(args: argparse.Namespace) -> int:
         from frontier_marl.training.plots import plot_action_histogram
 
         args.plot.parent.mkdir(parents=True, exist_ok=True)
-        plot_action_histogram(result["rows"], args.plot, title=f"{loaded.path.name}: actions")
+        title = f"{Path(result['model_path']).name}: actions"
+        plot_action_histogram(result["rows"], args.plot, title=title)
         print(f"wrote {args.plot}")
-    return 0

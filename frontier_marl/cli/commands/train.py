@@ -158,6 +158,7 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
         own = "; ".join(
             f"{name}: {reg.label_episodes_of(name)}, one decision in {reg.label_every_of(name)}"
             for name in reg.per_family
+            if name in settings.families  # the others are not labelled
         )
         budget = (
             f"cost regression: {reg.rounds} rounds of {reg.label_episodes} labelled training "

@@ -18,7 +18,7 @@ from typing import Any
 
 from frontier_marl.config import EnvConfig, config_to_dict, make_config
 from frontier_marl.evaluation.benchmark.families import OBSERVATION_KEYS, world_settings
-from frontier_marl.evaluation.model_refs import cached_model, cached_scorer, source_of
+from frontier_marl.evaluation.model_refs import ScorerMaker, cached_model, cached_scorer, source_of
 from frontier_marl.policies.base import ModelPolicy
 from frontier_marl.policies.lookahead import LookaheadOracle
 from frontier_marl.policies.models import (
@@ -26,6 +26,7 @@ from frontier_marl.policies.models import (
     LoadedModel,
     check_model_env,
     map_scorer_folder,
+    renamed_hint,
 )
 from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
 
@@ -99,21 +100,6 @@ class ModelWorld:
         return cfg
 
 
-@dataclass(frozen=True)
-class ScorerMaker:
-    """``make`` of a saved map scorer: a :class:`MapExplorer` labelled ``label``, with the
-    weight of frontier-rule's margin its training chose (``rule_weight`` in its metadata)."""
-
-    folder: str
-    label: str
-
-    def __call__(self) -> Any:
-        from frontier_marl.policies.map_explorer import MapExplorer  # torch: loaded_scorer's
-
-        model, metadata = cached_scorer(self.folder)
-        return MapExplorer(model, self.label, float(metadata.get("rule_weight", 0.0)))
-
-
 def heuristic(name: str, commit: str = "until-progress") -> Contender:
     """A heuristic of the registry, with ``commit`` where it takes one; one that reads an
     observation layout of its own (``frontier-rule``) runs with it on the family's world."""
@@ -162,6 +148,7 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
             raise ValueError(
                 f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), {ORACLE}, "
                 f"a shipped model ({', '.join(PRETRAINED)}), nor a model file or run folder"
+                + renamed_hint(name)
             )
     labels = [contender.name for contender in out]
     repeated = sorted({label for label in labels if labels.count(label) > 1})

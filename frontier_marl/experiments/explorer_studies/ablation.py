@@ -1,4 +1,5 @@
-"""What each part of `explorer` is worth (docs/beyond-the-thesis.md, "Ablation").
+"""What each part of the linear slot scorer (now ``frontier-rule``) is worth
+(docs/beyond-the-thesis.md, "Ablation").
 
 Scores, on the same validation episodes of every family (seeds 800,000+, never the held-out
 ones), with ``frontier-marl benchmark``:
@@ -12,10 +13,10 @@ ones), with ``frontier-marl benchmark``:
   CEM starts): long frontier pieces before specks on fine grids, about neutral on coarse ones;
 * ``explorer-dqn``: the DQN-trained slot scorer (no tour feature; a research model in the
   repository's ``training/models/``, not in the wheel);
-* ``explorer``: the shipped CEM-trained linear scorer (with the tour, unknown-near and fill
-  features);
+* ``frontier-rule``: the CEM-checked linear scorer with the tour, unknown-near and fill
+  features (the shipped ``explorer`` until the map-aware model replaced it);
 * any further model given with ``--models`` (e.g. a CEM run without the tour feature:
-  ``frontier-marl train explorer --set env.tour=false --out runs/no-tour``, then
+  ``frontier-marl train explorer-cem --set env.tour=false --out runs/no-tour``, then
   ``cp -r runs/no-tour/best runs/explorer-no-tour``: a model is labelled by its folder).
 
     python benchmarks/explorer_ablation.py --episodes 64 \\
@@ -40,7 +41,7 @@ HAND_SET = {
 
 def save_rules(out: Path) -> list[str]:
     """Save the hand-set linear scorers under ``out``; returns their folders."""
-    experiment = load_experiment("explorer")
+    experiment = load_experiment("explorer-cem")
     for label, weights in HAND_SET.items():
         save_hand_set(weights, out / label, experiment)
     return [str(out / label) for label in HAND_SET]
@@ -64,7 +65,7 @@ def benchmark_command(
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    policies = ["nearest-path", *save_rules(args.out), str(explorer_dqn), "explorer"]
+    policies = ["nearest-path", *save_rules(args.out), str(explorer_dqn), "frontier-rule"]
     policies += [m for m in args.models.split(",") if m]
     command = ["benchmark", "--split", "validation", "--episodes", str(args.episodes)]
     command += ["--policies", ",".join(policies)]

@@ -1,7 +1,7 @@
 """What each part of the map-aware explorer is worth: an ablation on a run's labels and on
 validation seeds (docs/experiments/2026-12-04-map-aware-explorer.md).
 
-A cost-regression run (``frontier-marl train explorer-map``) keeps each round's labels in
+A cost-regression run (``frontier-marl train explorer``) keeps each round's labels in
 ``RUN/labels/``. This fits one scorer per variant on every round but the last (or the first
 ``--train-rounds``: a learning curve; a one-round run, or ``--train-rounds`` set to all of
 them, fits every round and has no held-out decisions), with the run's fit settings

@@ -3,7 +3,7 @@ seeds, and their average (docs/experiments/2026-12-04-map-aware-explorer.md). Va
 only.
 
 It fits ``max(--sizes)`` scorers on every round's labels of a cost-regression run (``frontier-
-marl train explorer-map``), with the run's fit settings and the seeds ``seed``, ``seed + 1``,
+marl train explorer``), with the run's fit settings and the seeds ``seed``, ``seed + 1``,
 ..., and scores, for each k of ``--sizes``, the mean predicted regret of the first k
 (:class:`Averaged`) against frontier-rule on ``--episodes`` validation episodes of every family
 at each rule weight of ``--weights`` (k = 1 is one plain fit)::

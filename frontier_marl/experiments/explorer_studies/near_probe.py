@@ -86,7 +86,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--first .. --first + --episodes must be training seeds, in {TRAIN_SEEDS}")
     radii = parse_list(args.radii, int, "--radii", parser)
     weights = parse_list(args.weights, float, "--weights", parser)
-    experiment = load_experiment("explorer")
+    experiment = load_experiment("explorer-cem")
     seeds = list(range(args.first, args.first + args.episodes))
     variants = {"rule": (0, 0.0)} | {f"R{r} W{w:+g}": (r, w) for r in radii for w in weights}
     rows = []

@@ -1,10 +1,11 @@
-"""How far below the explorer one step of lookahead on the true map goes: a privileged bound.
+"""How far below frontier-rule one step of lookahead on the true map goes: a privileged bound.
 
 ``lookahead-oracle`` simulates each candidate cluster on the true map and lets nearest-path
-finish (rollout on nearest-path). ``explorer-rollout`` is the same with the shipped
-``explorer`` finishing each simulation (its observation and weights), so it is one step of
-policy improvement over the explorer itself, and its costs are the labels a student of the
-explorer would need. Both read the true map: bounds, not contenders. Validation episodes::
+finish (rollout on nearest-path). ``explorer-rollout`` is the same with frontier-rule
+(the linear ``explorer`` until the map-aware model replaced it) finishing each simulation (its
+observation and weights), so it is one step of policy improvement over the rule itself, and
+its costs are the labels a student of the rule would need. Both read the true map: bounds,
+not contenders. Validation episodes::
 
     python benchmarks/explorer_rollout_probe.py --families random-20,random-30,rooms-32 \\
         --episodes 16 --json training/results/explorer/rollout-probe.json
@@ -19,11 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.benchmark.run import Contender, contenders, model, run_benchmark
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic, run_benchmark
 from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.lookahead import LinearScorerBase, LookaheadOracle
-from frontier_marl.training.cem import shipped_weights
 
 
 class ExplorerRollout(LookaheadOracle):
@@ -44,10 +45,13 @@ class ExplorerRollout(LookaheadOracle):
 
 
 def explorer_rollout() -> Contender:
-    """``explorer-rollout`` with the shipped explorer's weights, in the explorer's env."""
-    weights = shipped_weights()
+    """``explorer-rollout`` with frontier-rule's weights, in frontier-rule's env."""
+    weights = dict(FRONTIER_RULE_WEIGHTS)
     return Contender(
-        ExplorerRollout.name, False, lambda: ExplorerRollout(weights), model("explorer").config
+        ExplorerRollout.name,
+        False,
+        lambda: ExplorerRollout(weights),
+        heuristic("frontier-rule").config,
     )
 
 
@@ -63,7 +67,10 @@ def main(argv: list[str] | None = None) -> int:
         check_families(names, "--families")
     except ValueError as exc:
         parser.error(f"{exc} (valid: {', '.join(FAMILIES)})")
-    policies = [*contenders(["nearest-path", "explorer", "lookahead-oracle"]), explorer_rollout()]
+    policies = [
+        *contenders(["nearest-path", "frontier-rule", "lookahead-oracle"]),
+        explorer_rollout(),
+    ]
     rows = run_benchmark(
         [family(name) for name in names],
         policies,

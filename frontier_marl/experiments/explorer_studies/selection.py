@@ -1,4 +1,5 @@
-"""Choose between explorer candidates on validation episodes no training run has used.
+"""Choose between explorer candidates on validation episodes no training run has used (beside
+frontier-rule, the linear ``explorer`` until the map-aware model replaced it).
 
 ``frontier-marl train`` validates on the first validation seeds of each family (800,000 and
 up; the explorer configs use at most 48), and keeps the generation that scores best there, so
@@ -42,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     heuristics = [h for h in args.heuristics.split(",") if h]
     if not heuristics:
         parser.error("--heuristics must name at least one heuristic")
-    names = [*heuristics, "explorer", *[m for m in args.models.split(",") if m]]
+    names = [*heuristics, "frontier-rule", *[m for m in args.models.split(",") if m]]
     seeds = range(args.first, VALIDATION_SEEDS.stop)
     rows = run_on_seeds(names, seeds, args.episodes, progress=not args.no_progress)
     print(format_table(rows))

@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
         weights = [float(w) for w in args.weights.split(",")]
     except ValueError:
         parser.error(f"--weights must be comma-separated numbers, got {args.weights!r}")
-    experiment = load_experiment("explorer")
+    experiment = load_experiment("explorer-cem")
     folders = []
     for weight in weights:
         folder = args.out / f"tour{weight:+g}"

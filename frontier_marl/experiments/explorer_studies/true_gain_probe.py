@@ -1,12 +1,13 @@
 """Would the explorer gain from knowing what each frontier would reveal? A privileged probe.
 
-Each slot gets one more score term, ``W * gain``, beside the shipped explorer's weights:
-``gain`` is the share of the sensor's disc that one sensing at the slot's target would
-newly reveal, computed on the TRUE map (``true``: line of sight through the true walls, as
-the env senses) or, as a control without privilege, the unknown share of that disc in the
-belief (``belief``: no occlusion). Every W of ``--weights`` plays the same training episodes
-of every family of the ``explorer`` config as the shipped weights (W = 0), played as CEM plays
-them; the paired per-episode T99 change is reported with its standard error::
+Each slot gets one more score term, ``W * gain``, beside frontier-rule's weights (the linear
+``explorer``'s until the map-aware model replaced it): ``gain`` is the share of the sensor's
+disc that one sensing at the slot's target would newly reveal, computed on the TRUE map
+(``true``: line of sight through the true walls, as the env senses) or, as a control without
+privilege, the unknown share of that disc in the belief (``belief``: no occlusion). Every W of
+``--weights`` plays the same training episodes of every family of the ``explorer-cem`` config
+as the unchanged weights (W = 0), played as CEM plays them; the paired per-episode T99 change
+is reported with its standard error::
 
     python benchmarks/explorer_true_gain_probe.py --weights=-0.25,-0.1,0.1,0.25 \\
         --episodes 64 --first 736000 --json training/results/explorer/true-gain-probe.json
@@ -31,8 +32,9 @@ from frontier_marl.core.grid import UNKNOWN
 from frontier_marl.core.sensing import reveal
 from frontier_marl.envs.vector import FrontierVectorEnv
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
-from frontier_marl.training.cem import changes_text, paired_change, play_scorer, shipped_weights
+from frontier_marl.training.cem import changes_text, paired_change, play_scorer
 from frontier_marl.training.experiment import load_experiment
 
 KINDS = ("true", "belief")
@@ -118,8 +120,8 @@ def _family_rows(
 
 def main(argv: list[str] | None = None) -> int:
     args, weights, kinds = _parse_args(argv)
-    experiment = load_experiment("explorer")
-    shipped = shipped_weights()
+    experiment = load_experiment("explorer-cem")
+    shipped = dict(FRONTIER_RULE_WEIGHTS)
     seeds = list(range(args.first, args.first + args.episodes))
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
@@ -130,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{family}: {cells}  ({time.perf_counter() - started:.0f} s)", flush=True)
     if args.json is not None:
         options = {"weights": weights, "kinds": kinds, "episodes": args.episodes}
-        what = "mean paired per-episode T99 change against the explorer's shipped weights"
+        what = "mean paired per-episode T99 change against frontier-rule's weights"
         payload = {"what": what, "options": {**options, "first_seed": args.first}, "rows": rows}
         args.json.write_text(json.dumps(payload, indent=1))
     return 0

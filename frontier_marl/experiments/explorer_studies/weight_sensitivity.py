@@ -1,9 +1,11 @@
-"""How much the shipped explorer's T99 moves when its weights move, on several sets of episodes.
+"""How much frontier-rule's T99 moves when its weights move, on several sets of episodes.
+
+frontier-rule's weights were the linear ``explorer``'s until the map-aware model replaced it.
 
 For every ``NAME:FACTOR`` of ``--directions`` (``NAME`` a feature, or ``lengths`` for every
 weight on a length feature at once: path, distance, d_row, d_col, isolation, extra_path, tour),
-the explorer's weights with that weight multiplied by ``FACTOR`` play the same training
-episodes of every family of the ``explorer`` config as the unchanged weights, played as CEM
+frontier-rule's weights with that weight multiplied by ``FACTOR`` play the same training
+episodes of every family of the ``explorer-cem`` config as the unchanged weights, played as CEM
 plays them; the paired per-episode T99 change is reported with its standard error, once per
 seed set of ``--seed-sets`` (disjoint sets of training seeds). A change that is real shows on
 every set; one that shows on a single set is the noise of that set's episodes::
@@ -25,8 +27,9 @@ import numpy as np
 
 from frontier_marl.config import EnvConfig
 from frontier_marl.evaluation.benchmark.families import TRAIN_SEEDS
+from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
-from frontier_marl.training.cem import changes_text, paired_change, play_t99, shipped_weights
+from frontier_marl.training.cem import changes_text, paired_change, play_t99
 from frontier_marl.training.experiment import load_experiment
 
 DIRECTIONS = "lengths:1.25,lengths:1.6,tour:0.8,tour:1.25,unknown_near:0.7,unknown_near:1.4"
@@ -110,13 +113,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     firsts = _seed_sets(parser, args)
-    experiment = load_experiment("explorer")
+    experiment = load_experiment("explorer-cem")
     names = feature_names(experiment.env_config())  # the same on every family
     try:
         directions = parse_directions(args.directions, names)
     except ValueError as exc:
         parser.error(str(exc))
-    weights = weight_vector(shipped_weights(), names, "the explorer's weights")
+    weights = weight_vector(FRONTIER_RULE_WEIGHTS, names, "frontier-rule's weights")
     rows = []
     for family, cfg in zip(experiment.train.families, experiment.env_configs(), strict=True):
         started = time.perf_counter()
@@ -126,6 +129,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{family}: {cells}  ({time.perf_counter() - started:.0f} s)", flush=True)
     if args.json is not None:
         options = {"episodes": args.episodes, "seed_sets": firsts, "directions": args.directions}
-        what = "mean paired per-episode T99 change against the explorer's shipped weights"
+        what = "mean paired per-episode T99 change against frontier-rule's weights"
         args.json.write_text(json.dumps({"what": what, "options": options, "rows": rows}, indent=1))
     return 0

@@ -1,7 +1,7 @@
 """Inference speed of the map-aware explorer: decisions per second on one core.
 
     python benchmarks/bench_map_explorer.py                        # rooms-64, a fresh scorer
-    python benchmarks/bench_map_explorer.py --model runs/explorer-map/best --json out.json
+    python benchmarks/bench_map_explorer.py --model runs/explorer/best --json out.json
 
 Plays the first ``--episodes`` validation episodes of ``--family`` with a
 :class:`~frontier_marl.policies.map_explorer.MapExplorer` (torch and numba on one thread) and
