@@ -235,11 +235,6 @@ def map_scorer_env_config(
             f"set (it is {', '.join(repr(FRONTIER_RULE_SETTINGS[k]) for k in fixed)})"
         )
     world = make_config(preset or "thesis-20x20", **overrides)
-    if world.n_agents != 1:
-        raise ValueError(
-            f"a map scorer decides for one robot, got n_agents={world.n_agents} (a map-aware "
-            "team scorer is not built yet)"
-        )
     return own_world(FRONTIER_RULE_SETTINGS, world)
 
 

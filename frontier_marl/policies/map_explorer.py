@@ -16,6 +16,7 @@ needs torch and no training library.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -67,7 +68,8 @@ class MapExplorer(Policy):
     slot's rule margin is how far frontier-rule's score of it falls below the best slot's
     (0 for the rule's own choice): ``rule_weight`` 0 is the scorer alone, a large one the
     rule, between them the scorer overrules the rule only where it predicts a clear gain.
-    One robot (a team's robots would need their own slot tables: not built yet)."""
+    In a team each robot decides alone, from its own slots and the crops around them (the
+    scorer was trained for one robot and sees no teammates)."""
 
     deterministic = True
 
@@ -84,11 +86,6 @@ class MapExplorer(Policy):
         return cls(model, name, float(metadata.get("rule_weight", 0.0)))
 
     def attach(self, env: Any) -> None:
-        if env.config.n_agents != 1:
-            raise ValueError(
-                f"{self.name} decides for one robot; the env has n_agents="
-                f"{env.config.n_agents} (a map-aware team scorer is not built yet)"
-            )
         expected = self.model.feature_mean.numel()
         if len(feature_names(env.config)) != expected:
             raise ValueError(
@@ -100,13 +97,29 @@ class MapExplorer(Policy):
         self._rule = weight_vector(FRONTIER_RULE_WEIGHTS, names, "frontier-rule")
 
     def act(self, obs: Any, info: Info) -> int:
+        return self._choose(obs, 0)
+
+    def act_team(
+        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
+    ) -> dict[str, int]:
+        robots = self._attached().possible_agents
+        return {
+            agent: self._choose(obs, robots.index(agent)) for agent, obs in observations.items()
+        }
+
+    def _attached(self) -> Any:
         if self._env is None:
             raise RuntimeError(f"{self.name} needs attach(env) before it acts")
+        return self._env
+
+    def _choose(self, obs: Any, robot: int) -> int:
+        """The slot ``robot`` (its index in the env's agents) takes, given its observation."""
+        env = self._attached()
         slots, mask = explorer_slots(obs)
         valid = np.flatnonzero(mask > 0)
         if len(valid) <= 1:
             return int(valid[0]) if len(valid) else 0
-        crops = slot_crops(self._env, valid)
+        crops = slot_crops(env, valid, robot)
         features = torch.as_tensor(slots[valid], dtype=torch.float32)[None]
         mask = torch.ones((1, len(valid)), dtype=torch.bool)
         with torch.no_grad():
