@@ -25,6 +25,12 @@ from frontier_marl.experiments.explorer_studies.map_scorer_ensemble import (  # 
 from frontier_marl.experiments.explorer_studies.map_scorer_ensemble import (  # noqa: E402
     main as ensemble_main,
 )
+from frontier_marl.experiments.explorer_studies.map_scorer_mix import (  # noqa: E402
+    main as mix_main,
+)
+from frontier_marl.experiments.explorer_studies.map_scorer_mix import (  # noqa: E402
+    mixed_labels,
+)
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
 from frontier_marl.policies import map_crops  # noqa: E402
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS  # noqa: E402
@@ -229,6 +235,27 @@ def test_a_fit_depends_on_its_seed_alone(labelled: Samples) -> None:
     assert not all(torch.equal(first[key], other[key]) for key in first)
 
 
+def test_a_fit_runs_on_one_torch_thread_and_gives_the_threads_back(
+    labelled: Samples, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On two threads the same fit gave other weights from one process to the next."""
+    seen = []
+    real_fit = cost_regression.fit
+
+    def recording_fit(*args: object, **kwargs: object) -> list[float]:
+        seen.append(torch.get_num_threads())
+        return real_fit(*args, **kwargs)
+
+    monkeypatch.setattr(cost_regression, "fit", recording_fit)
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        cost_regression.fitted(labelled, cost_regression.RegressionSettings(fit_epochs=1), 0)
+        assert seen == [1] and torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
+
+
 @pytest.mark.slow
 def test_train_explorer_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
@@ -296,6 +323,34 @@ def test_train_explorer_writes_a_scorer_that_the_benchmark_runs(tmp_path: Path, 
     assert ensemble["labels"] == 2 * records[1]["labels"]  # the run's labels and --with's
     assert list(ensemble["sizes"]) == ["1", "2"]
     assert set(ensemble["sizes"]["2"]["1.0"]["by_family"]) == {"random-20"}
+    true_run = tmp_path / "true-map"  # round 0 again, on the true map: the same decisions
+    tiny["regression.completions"], tiny["regression.rounds"] = 0, 1
+    sets = [arg for key, value in tiny.items() for arg in ("--set", f"{key}={value}")]
+    assert main(["train", "explorer", "--out", str(true_run), "--no-progress", *sets]) == 0
+    mix_json = tmp_path / "mix.json"
+    mix_args = ["--alphas", "0,1", "--weights", "0", "--episodes", "1", "--epochs", "1"]
+    assert mix_main([str(out), str(true_run), *mix_args, "--json", str(mix_json)]) == 0
+    mix = json.loads(mix_json.read_text())
+    assert mix["labels"] == records[0]["labels"] and list(mix["alphas"]) == ["0.0", "1.0"]
+    with pytest.raises(SystemExit):  # a folder without labels
+        mix_main([str(out), str(tmp_path / "kept"), *mix_args])
+
+
+def test_mixed_labels_weigh_the_true_cost_on_the_same_decisions_only() -> None:
+    crops = np.zeros((3, *map_crops.crop_shape()), np.uint8)
+    features = np.zeros((3, 14), np.float32)
+    decision, family = np.array([0, 0, 1]), np.array(["rooms-32"] * 3)
+    soft = Samples(crops, features, np.array([10.0, 20.0, 30.0]), decision, family)
+    true = Samples(
+        np.zeros((4, *map_crops.crop_shape()), np.uint8), np.zeros((4, 14), np.float32),
+        np.array([14.0, 16.0, 38.0, 99.0]), np.array([0, 0, 1, 2]), np.array(["rooms-32"] * 4),
+    )  # fmt: skip
+    assert mixed_labels(soft, true, 0.25).cost.tolist() == [11.0, 19.0, 32.0]
+    moved = Samples(true.crops.copy(), true.features, true.cost, true.decision, true.family)
+    moved.crops[1, 0, 0, 0] = 1  # another belief at the same position
+    for other, alpha in ((moved, 0.5), (true, 1.5)):
+        with pytest.raises(ValueError, match="not the same decisions|alpha must be in"):
+            mixed_labels(soft, other, alpha)
 
 
 def test_an_average_of_one_scorer_is_that_scorer_and_of_two_their_mean() -> None:

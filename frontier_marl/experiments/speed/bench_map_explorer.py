@@ -38,9 +38,9 @@ class _TimedCrops:
         self.original = map_explorer.slot_crops
         self.seconds = 0.0
 
-    def __call__(self, env: Any, slots: np.ndarray) -> np.ndarray:
+    def __call__(self, env: Any, slots: np.ndarray, robot: int = 0) -> np.ndarray:
         start = time.perf_counter()
-        crops = self.original(env, slots)
+        crops = self.original(env, slots, robot)
         self.seconds += time.perf_counter() - start
         return crops
 
