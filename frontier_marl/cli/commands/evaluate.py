@@ -140,17 +140,7 @@ def run(args: argparse.Namespace) -> int:
         )
 
     try:
-        result = evaluate_model(
-            loaded,
-            cfg,
-            episodes=args.episodes,
-            seed=args.seed,
-            heuristics=heuristics,
-            name="model",
-            jobs=args.jobs,
-            ray_address=args.ray_address,
-            progress=not args.no_progress,
-        )
+        result = evaluate_model(loaded, cfg, **_protocol(args, heuristics))
     except (ModelEnvMismatchError, ConnectionError) as exc:
         return _fail(str(exc))
     _report(args, result, f"{loaded.path} ({result['num_timesteps']} training steps)", cfg)
@@ -164,20 +154,23 @@ def _run_map_scorer(
     overrides.setdefault("map_mode", "dynamic")
     try:
         cfg = map_scorer_env_config(args.preset, overrides)
-        result = evaluate_map_scorer(
-            folder,
-            cfg,
-            episodes=args.episodes,
-            seed=args.seed,
-            heuristics=heuristics,
-            jobs=args.jobs,
-            ray_address=args.ray_address,
-            progress=not args.no_progress,
-        )
+        result = evaluate_map_scorer(folder, cfg, **_protocol(args, heuristics))
     except (ValueError, ConnectionError) as exc:
         return _fail(str(exc))
     _report(args, result, f"{folder} (map scorer, {result['labels']:,} labelled candidates)", cfg)
     return 0
+
+
+def _protocol(args: argparse.Namespace, heuristics: list[str]) -> dict[str, Any]:
+    """The episodes, heuristics and workers of the command line, for either kind of model."""
+    return {
+        "episodes": args.episodes,
+        "seed": args.seed,
+        "heuristics": heuristics,
+        "jobs": args.jobs,
+        "ray_address": args.ray_address,
+        "progress": not args.no_progress,
+    }
 
 
 def _report(args: argparse.Namespace, result: dict[str, Any], what: str, cfg: EnvConfig) -> None:
