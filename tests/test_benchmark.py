@@ -417,3 +417,17 @@ def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
     assert all(row["decisions_per_s"] > 0 for row in rows)
     with pytest.raises(SystemExit):
         bench.main(["--worlds", "0"])
+
+
+def test_a_policy_refusing_inside_an_episode_is_one_line_naming_the_episode(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def refuse(self, observations, infos):
+        raise ValueError("this policy cannot act here")
+
+    monkeypatch.setattr(NearestPath, "act_team", refuse)
+    argv = ["benchmark", "--no-progress", "--families", "random-20", "--episodes", "1"]
+    assert main([*argv, "--policies", "nearest-path", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert "this policy cannot act here; while running episode 900000 of nearest-path" in err

@@ -173,7 +173,11 @@ def check_parallel_arguments(args: argparse.Namespace) -> None:
             raise ValueError(f"--ray-address: {exc}") from None
 
 
-def fail(command: str, message: str) -> int:
+def fail(command: str, message: str | Exception) -> int:
+    """Print the one-line error of ``command`` (an exception's message with its notes, e.g.
+    which episode raised it) and return exit status 2."""
+    if isinstance(message, Exception):
+        message = "; ".join([str(message), *getattr(message, "__notes__", ())])
     print(f"frontier-marl {command}: error: {message}", file=sys.stderr)
     return 2
 

@@ -147,8 +147,8 @@ def run(args: argparse.Namespace) -> int:
             jobs=args.jobs,
             ray_address=args.ray_address,
         )
-    except ConnectionError as exc:
-        return fail("benchmark", str(exc))
+    except (ValueError, ConnectionError) as exc:  # e.g. a policy refusing a family's world
+        return fail("benchmark", exc)
     wall = time.perf_counter() - start
     first = (
         map_families.HELDOUT_SEEDS if args.split == "heldout" else map_families.VALIDATION_SEEDS
