@@ -11,6 +11,7 @@ import pytest
 import torch
 
 import frontier_marl
+from frontier_marl.core.grid import FREE, OCCUPIED, UNKNOWN
 from frontier_marl.core.sensing import make_sensor
 from frontier_marl.core.world import World, WorldParams
 from frontier_marl.policies.lookahead import LookaheadOracle, lookahead_costs
@@ -207,3 +208,25 @@ def test_the_completions_study_plays_its_planner_on_validation_episodes(tmp_path
     env = frontier_marl.FrontierParallelEnv(preset="thesis-20x20", map_mode="static")
     with pytest.raises(ValueError, match="dynamic generated maps"):
         planner.attach(env)
+
+
+def test_matched_completions_keep_the_draws_whose_walls_continue_the_belief() -> None:
+    from frontier_marl.experiments.explorer_studies.completions import (
+        best_matching,
+        completions_name,
+    )
+
+    belief = np.full((3, 4), UNKNOWN, dtype=np.int8)
+    belief[:, :2] = FREE
+    belief[0, 1] = OCCUPIED  # column 1 borders the unknown: wall, free, free
+    blocked = np.zeros((3, 4), dtype=bool)
+    blocked[:, 1] = True  # agrees on one of the three
+    half = blocked.copy()
+    half[1, 1] = False  # two
+    walled = np.zeros((3, 4), dtype=bool)
+    walled[0, 1] = True  # three
+    open_map = np.zeros((3, 4), dtype=bool)  # two
+    kept = best_matching([blocked, half, walled, open_map], belief, 2, band=1)
+    assert kept[0] is walled and kept[1] is half  # a tie keeps the earlier draw
+    assert completions_name(8, 1, 3) == "completions-8"
+    assert completions_name(8, 4, 2) == "completions-8-of-32-b2"

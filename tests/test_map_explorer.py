@@ -552,9 +552,34 @@ def test_a_bad_per_family_entry_is_named() -> None:
 
 def test_the_shipped_explorer_is_the_committed_configs_scorer() -> None:
     model, meta = load_scorer("explorer")
-    assert meta["format"] == "map-scorer" and meta["rule_weight"] == 0.5
     committed = load_experiment("explorer").to_dict()
+    assert meta["format"] == "map-scorer" and meta["experiment"]["name"] == "explorer"
+    assert meta["rule_weight"] == 1.0 and 1.0 in committed["regression"]["rule_weights"]
     assert {k: meta["experiment"][k] for k in ("train", "regression")} == {
         k: committed[k] for k in ("train", "regression")
     }
     assert model.feature_mean.numel() == len(feature_names(scorer_config(make_config(None))))
+
+
+def test_the_team_claims_study_discounts_targets_near_claimed_ones(tmp_path: Path) -> None:
+    from frontier_marl.experiments.explorer_studies import team_claims
+
+    shipped = MapExplorer.load(map_scorer_folder("explorer"))
+    explorer = team_claims.make_claiming(1.0, 4.0, None)
+    assert explorer.name == "claims-d1-r4" and explorer.rule_weight == shipped.rule_weight
+    assert team_claims.make_claiming(1.0, 4.0, 2.0).rule_weight == 2.0
+    targets = np.array([[0, 0], [0, 10], [4, 4]])
+    crowding = explorer._crowding(targets, [np.array([0, 2]), np.array([0, 0])])
+    assert crowding.tolist() == pytest.approx([0.5 + 1.0, 0.0, 0.0])
+    assert team_claims.parse_variant("0.3:5:2") == (0.3, 5.0, 2.0)
+    for bad in ("1", "a:5", "1:0", "-1:5"):
+        with pytest.raises(ValueError, match="variant"):
+            team_claims.parse_variant(bad)
+    out = tmp_path / "claims.json"
+    argv = ["--families", "random-20", "--agents", "2", "--variants", "1:5", "--episodes", "1"]
+    assert team_claims.main([*argv, "--jobs", "1", "--no-progress", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [row["policy"] for row in rows] == [*team_claims.BASELINES, "claims-d1-r5"]
+    assert all(row["seeds"] == [800_000] and row["success"] == 1 for row in rows)
+    with pytest.raises(SystemExit):
+        team_claims.main(["--agents", "1"])

@@ -112,19 +112,27 @@ class MapExplorer(Policy):
             raise RuntimeError(f"{self.name} needs attach(env) before it acts")
         return self._env
 
-    def _choose(self, obs: Any, robot: int) -> int:
-        """The slot ``robot`` (its index in the env's agents) takes, given its observation."""
+    def slot_scores(self, obs: Any, robot: int) -> tuple[np.ndarray, np.ndarray]:
+        """The valid slots of ``robot``'s observation (its index in the env's agents) and
+        the score the explorer takes the least of among them (predicted regret plus
+        ``rule_weight`` times the rule margin); all zero where one slot or none is valid."""
         env = self._attached()
         slots, mask = explorer_slots(obs)
         valid = np.flatnonzero(mask > 0)
         if len(valid) <= 1:
-            return int(valid[0]) if len(valid) else 0
+            return valid, np.zeros(len(valid))
         crops = slot_crops(env, valid, robot)
         features = torch.as_tensor(slots[valid], dtype=torch.float32)[None]
         mask = torch.ones((1, len(valid)), dtype=torch.bool)
         with torch.no_grad():
             regret = self.model(torch.as_tensor(crops)[None], features, mask)[0].numpy()
+        regret = regret.astype(np.float64)
         if self.rule_weight:
             rule = slots[valid].astype(np.float64) @ self._rule
             regret = regret + self.rule_weight * (rule.max() - rule)
-        return int(valid[int(np.argmin(regret))])
+        return valid, regret
+
+    def _choose(self, obs: Any, robot: int) -> int:
+        """The slot ``robot`` (its index in the env's agents) takes, given its observation."""
+        valid, scores = self.slot_scores(obs, robot)
+        return int(valid[int(np.argmin(scores))]) if len(valid) else 0

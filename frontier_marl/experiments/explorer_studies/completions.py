@@ -13,6 +13,10 @@ lies mostly in what no belief shows.
     python benchmarks/explorer_completions.py --families random-20,random-30,rooms-32 \\
         --samples 1,8 --episodes 16
 
+``--match R`` draws ``R × K`` maps and keeps the ``K`` that agree most with the belief on the
+known cells within ``--band`` cells of the unknown (a crude approximate-Bayesian filter: draws
+whose walls continue the ones the robot sees near its frontiers are kept).
+
 Validation episodes only. It reads the generator of the env's family, so it refuses loaded or
 static maps (a draw would be the true map).
 """
@@ -25,6 +29,10 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from scipy import ndimage
+
+from frontier_marl.core.grid import OCCUPIED, UNKNOWN
 from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
 from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_benchmark
 from frontier_marl.evaluation.benchmark.stats import format_table
@@ -44,13 +52,17 @@ class CompletionLookahead(HeuristicPolicy):
     (:func:`~frontier_marl.policies.lookahead.completion_draws`; ties: nearest path, then
     nearest centroid), kept until reached."""
 
-    def __init__(self, samples: int, seed: int = 0) -> None:
+    def __init__(self, samples: int, seed: int = 0, match: int = 1, band: int = 3) -> None:
         super().__init__("until-reached")
-        if samples < 1:
-            raise ValueError(f"samples must be >= 1, got {samples}")
+        if samples < 1 or match < 1 or band < 1:
+            raise ValueError(
+                f"samples, match and band must be >= 1, got {samples}, {match} and {band}"
+            )
         self.samples = samples
         self.seed = seed
-        self.name = f"completions-{samples}"
+        self.match = match
+        self.band = band
+        self.name = completions_name(samples, match, band)
         self._env: Any = None
         self._source: EpisodeSource | None = None
 
@@ -68,8 +80,10 @@ class CompletionLookahead(HeuristicPolicy):
         world = self._env.world
         height, width = world.shape
         maps = completion_draws(
-            self._source, world.belief, world.positions, self.samples, self.seed
+            self._source, world.belief, world.positions, self.samples * self.match, self.seed
         )
+        if self.match > 1:
+            maps = best_matching(maps, world.belief, self.samples, self.band)
         live = table.live
         costs = completion_costs(
             world.batch, world.index, table.target[:live],
@@ -78,15 +92,33 @@ class CompletionLookahead(HeuristicPolicy):
         return first_by(costs, table.path_length[:live], table.distance[:live])
 
 
-def contenders(samples: list[int], oracle: bool) -> list[Contender]:
-    """frontier-rule, the sampled lookahead for each K of ``samples`` and (``oracle``) the
-    true-map oracle, all in frontier-rule's env."""
+def completions_name(samples: int, match: int, band: int) -> str:
+    """``completions-K``, or ``completions-K-of-RK-bB`` for draws kept by their match."""
+    return f"completions-{samples}" + (f"-of-{samples * match}-b{band}" if match > 1 else "")
+
+
+def best_matching(
+    maps: list[np.ndarray], belief: np.ndarray, keep: int, band: int
+) -> list[np.ndarray]:
+    """The ``keep`` of ``maps`` (occupancy grids) that agree with ``belief`` on the most known
+    cells within ``band`` cells (8-connected) of an unknown one; ties keep the earlier draw."""
+    unknown = belief == UNKNOWN
+    near = ndimage.binary_dilation(unknown, np.ones((3, 3), bool), iterations=band) & ~unknown
+    wall = belief[near] == OCCUPIED
+    agree = [np.count_nonzero(np.asarray(grid, dtype=bool)[near] == wall) for grid in maps]
+    order = np.argsort(-np.asarray(agree), kind="stable")[:keep]
+    return [maps[i] for i in order]
+
+
+def contenders(samples: list[int], oracle: bool, match: int = 1, band: int = 3) -> list[Contender]:
+    """frontier-rule, the sampled lookahead for each K of ``samples`` (each kept from
+    ``match`` × K draws by :func:`best_matching`) and (``oracle``) the true-map oracle, all in
+    frontier-rule's env."""
     rule = heuristic("frontier-rule")
     out = [rule]
     for k in samples:
-        out.append(
-            Contender(f"completions-{k}", False, partial(CompletionLookahead, k), rule.config)
-        )
+        planner = partial(CompletionLookahead, k, match=match, band=band)
+        out.append(Contender(completions_name(k, match, band), False, planner, rule.config))
     if oracle:
         out.append(Contender("oracle-np-12", False, LookaheadOracle, rule.config))
     return out
@@ -97,6 +129,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--families", default="random-20,random-30,rooms-32")
     parser.add_argument("--samples", default="1,8", help="comma-separated K: maps per decision")
     parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
+    parser.add_argument(
+        "--match", type=int, default=1, help="draw this many times K maps, keep the K that match"
+    )
+    parser.add_argument("--band", type=int, default=3, help="cells near the unknown to match on")
     parser.add_argument("--no-oracle", action="store_true", help="leave the true-map oracle out")
     parser.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
     parser.add_argument("--json", type=Path, default=None)
@@ -110,9 +146,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"{exc} (families: {', '.join(FAMILIES)}; samples: integers >= 1)")
     if min(samples) < 1:
         parser.error(f"--samples must be integers >= 1, got {args.samples}")
+    if args.match < 1 or args.band < 1:
+        parser.error(f"--match and --band must be >= 1, got {args.match} and {args.band}")
     rows = run_benchmark(
         [family(name) for name in names],
-        contenders(samples, not args.no_oracle),
+        contenders(samples, not args.no_oracle, args.match, args.band),
         args.episodes,
         progress=not args.no_progress,
         split="validation",

@@ -1,0 +1,163 @@
+"""Does a claim discount make the single-robot map scorer a team policy?
+
+``explorer`` was trained for one robot and sees no teammates: in a team each robot picks
+alone, and robots crowd the same frontier. This study gives it the classic coordination of
+Burgard et al.: the robots that must decide pick one after another (the lowest score first),
+and every target already claimed (the heading of a teammate held to its target by the commit
+rule, or a target chosen earlier in the round) adds ``discount × max(0, 1 − d / reach)`` to
+the score of a slot whose target lies ``d`` cells from it. It plays validation episodes beside
+the team heuristics, the shipped ``team-explorer`` and ``explorer`` alone:
+
+    python benchmarks/explorer_team_claims.py --families random-30,rooms-64 --agents 4 \\
+        --variants 0.3:5,1:5,1:10,3:10 --episodes 16
+
+A variant is ``discount:reach`` or ``discount:reach:rule_weight`` (reach in cells; the
+default rule weight is the model's own).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Mapping
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic, run_benchmark
+from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.policies.base import Info
+from frontier_marl.policies.map_explorer import MapExplorer
+from frontier_marl.policies.models import map_scorer_folder
+
+BASELINES = ("utility-discount", "coordinated-assignment", "team-explorer", "explorer")
+
+
+class ClaimingExplorer(MapExplorer):
+    """The map scorer with claimed targets discounted (the module's docstring); ties go to
+    the nearer path, then the lower robot index."""
+
+    def __init__(self, explorer: MapExplorer, discount: float, reach: float) -> None:
+        if discount < 0 or reach <= 0:
+            raise ValueError(f"discount must be >= 0 and reach > 0, got {discount} and {reach}")
+        super().__init__(explorer.model, claims_name(discount, reach), explorer.rule_weight)
+        self.discount = discount
+        self.reach = reach
+
+    def act_team(
+        self, observations: Mapping[str, Any], infos: Mapping[str, Info]
+    ) -> dict[str, int]:
+        env = self._attached()
+        robots = list(env.possible_agents)
+        tables = env.mdp.slot_tables()
+        heading = env.mdp.batch.heading[0]
+        claimed = []  # a robot held to its target (one valid slot) or done claims its heading
+        choices: dict[str, int] = {}
+        pending = {}
+        for agent, obs in observations.items():
+            r = robots.index(agent)
+            valid, scores = self.slot_scores(obs, r)
+            if len(valid) <= 1:
+                choices[agent] = int(valid[0]) if len(valid) else 0
+                if len(valid) and heading[r, 0] >= 0:
+                    claimed.append(heading[r])
+            else:
+                table = tables[r]
+                pending[agent] = (valid, scores, table.target[valid], table.path_length[valid])
+        claimed += [
+            heading[r] for r, a in enumerate(robots) if a not in observations and heading[r, 0] >= 0
+        ]
+        while pending:
+            best = None
+            for agent, (_, scores, targets, lengths) in pending.items():
+                total = scores + self.discount * self._crowding(targets, claimed)
+                i = int(np.lexsort((lengths, total))[0])
+                key = (total[i], lengths[i], robots.index(agent))
+                if best is None or key < best[0]:
+                    best = (key, agent, i)
+            assert best is not None
+            _, agent, i = best
+            valid, _, targets, _ = pending.pop(agent)
+            choices[agent] = int(valid[i])
+            claimed.append(targets[i])
+        return choices
+
+    def _crowding(self, targets: np.ndarray, claimed: list[np.ndarray]) -> np.ndarray:
+        """Per target, the sum over claimed targets of ``max(0, 1 − distance / reach)``."""
+        out = np.zeros(len(targets))
+        for target in claimed:
+            distance = np.hypot(*(targets.astype(np.float64) - target).T)
+            out += np.maximum(0.0, 1.0 - distance / self.reach)
+        return out
+
+
+def claims_name(discount: float, reach: float) -> str:
+    return f"claims-d{discount:g}-r{reach:g}"
+
+
+def make_claiming(discount: float, reach: float, rule_weight: float | None) -> ClaimingExplorer:
+    """The shipped ``explorer`` with claims (picklable through :func:`functools.partial`)."""
+    folder = map_scorer_folder("explorer")
+    assert folder is not None, "the shipped explorer is a map scorer"
+    explorer = MapExplorer.load(folder)
+    if rule_weight is not None:
+        explorer.rule_weight = rule_weight
+    return ClaimingExplorer(explorer, discount, reach)
+
+
+def parse_variant(text: str) -> tuple[float, float, float | None]:
+    """``discount:reach[:rule_weight]`` (ValueError naming the variant otherwise)."""
+    parts = text.split(":")
+    try:
+        if len(parts) not in (2, 3):
+            raise ValueError
+        discount, reach = float(parts[0]), float(parts[1])
+        weight = float(parts[2]) if len(parts) == 3 else None
+    except ValueError:
+        raise ValueError(f"variant {text!r} is not discount:reach[:rule_weight]") from None
+    if discount < 0 or reach <= 0 or (weight is not None and weight < 0):
+        raise ValueError(f"variant {text!r}: discount and rule weight >= 0, reach > 0")
+    return discount, reach, weight
+
+
+def variant_contender(variant: tuple[float, float, float | None]) -> Contender:
+    discount, reach, weight = variant
+    name = claims_name(discount, reach) + ("" if weight is None else f"-w{weight:g}")
+    maker = partial(make_claiming, discount, reach, weight)
+    return Contender(name, False, maker, heuristic("frontier-rule").config)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--families", default="random-30,rooms-64")
+    parser.add_argument("--agents", type=int, default=4, help="robots per team (2 or more)")
+    parser.add_argument("--variants", default="0.3:5,1:5", help="discount:reach[:rule_weight],...")
+    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
+    parser.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
+    parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    names = args.families.split(",")
+    try:
+        check_families(names, "--families")
+        variants = [parse_variant(text) for text in args.variants.split(",")]
+    except ValueError as exc:
+        parser.error(f"{exc} (families: {', '.join(FAMILIES)})")
+    if args.agents < 2:
+        parser.error(f"--agents must be 2 or more, got {args.agents}")
+    rows = run_benchmark(
+        [family(name) for name in names],
+        contenders(BASELINES, "none") + [variant_contender(v) for v in variants],
+        args.episodes,
+        agents=args.agents,
+        progress=not args.no_progress,
+        split="validation",
+        jobs=args.jobs,
+    )
+    print(format_table(rows))
+    if args.json is not None:
+        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
+    return 0
