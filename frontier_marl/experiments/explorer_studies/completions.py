@@ -23,19 +23,15 @@ static maps (a draw would be the true map).
 
 from __future__ import annotations
 
-import argparse
-import json
 from functools import partial
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
 from frontier_marl.core.grid import OCCUPIED, UNKNOWN
-from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_benchmark
-from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.evaluation.benchmark.run import Contender, heuristic
+from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.base import HeuristicPolicy, Info, first_by, slot_table
 from frontier_marl.policies.lookahead import (
     LookaheadOracle,
@@ -125,38 +121,20 @@ def contenders(samples: list[int], oracle: bool, match: int = 1, band: int = 3) 
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--families", default="random-20,random-30,rooms-32")
+    parser = study_parser(__doc__, "random-20,random-30,rooms-32")
     parser.add_argument("--samples", default="1,8", help="comma-separated K: maps per decision")
-    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
     parser.add_argument(
         "--match", type=int, default=1, help="draw this many times K maps, keep the K that match"
     )
     parser.add_argument("--band", type=int, default=3, help="cells near the unknown to match on")
     parser.add_argument("--no-oracle", action="store_true", help="leave the true-map oracle out")
-    parser.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
-    parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    names = args.families.split(",")
     try:
-        check_families(names, "--families")
         samples = [int(k) for k in args.samples.split(",")]
-    except ValueError as exc:
-        parser.error(f"{exc} (families: {', '.join(FAMILIES)}; samples: integers >= 1)")
-    if min(samples) < 1:
+        if min(samples) < 1:
+            raise ValueError
+    except ValueError:
         parser.error(f"--samples must be integers >= 1, got {args.samples}")
     if args.match < 1 or args.band < 1:
         parser.error(f"--match and --band must be >= 1, got {args.match} and {args.band}")
-    rows = run_benchmark(
-        [family(name) for name in names],
-        contenders(samples, not args.no_oracle, args.match, args.band),
-        args.episodes,
-        progress=not args.no_progress,
-        split="validation",
-        jobs=args.jobs,
-    )
-    print(format_table(rows))
-    if args.json is not None:
-        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
-    return 0
+    return run_study(parser, args, contenders(samples, not args.no_oracle, args.match, args.band))

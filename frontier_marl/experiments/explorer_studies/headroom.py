@@ -13,14 +13,11 @@ Both read the true map (bounds, not contenders) and choose among exactly the slo
 
 from __future__ import annotations
 
-import argparse
-import json
-from pathlib import Path
+from functools import partial
 
-from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.benchmark.run import Contender, heuristic, run_benchmark
-from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.evaluation.benchmark.run import Contender, heuristic
 from frontier_marl.experiments.explorer_studies.rollout_probe import ExplorerRollout
+from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.lookahead import LookaheadOracle
 
@@ -32,31 +29,14 @@ def oracles() -> list[Contender]:
         rule,
         Contender("oracle-np-12", False, LookaheadOracle, rule.config),
         Contender(
-            "oracle-rule-12", False, lambda: ExplorerRollout(FRONTIER_RULE_WEIGHTS), rule.config
+            "oracle-rule-12",
+            False,
+            partial(ExplorerRollout, dict(FRONTIER_RULE_WEIGHTS)),
+            rule.config,
         ),
     ]
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--families", default="random-20,rooms-32")
-    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
-    parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--no-progress", action="store_true")
-    args = parser.parse_args(argv)
-    names = args.families.split(",")
-    try:
-        check_families(names, "--families")
-    except ValueError as exc:
-        parser.error(f"{exc} (valid: {', '.join(FAMILIES)})")
-    rows = run_benchmark(
-        [family(name) for name in names],
-        oracles(),
-        args.episodes,
-        progress=not args.no_progress,
-        split="validation",
-    )
-    print(format_table(rows))
-    if args.json is not None:
-        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
-    return 0
+    parser = study_parser(__doc__, "random-20,rooms-32")
+    return run_study(parser, parser.parse_args(argv), oracles())

@@ -13,15 +13,12 @@ not contenders. Validation episodes::
 
 from __future__ import annotations
 
-import argparse
-import json
 from collections.abc import Mapping
-from pathlib import Path
+from functools import partial
 from typing import Any
 
-from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic, run_benchmark
-from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic
+from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.lookahead import LinearScorerBase, LookaheadOracle
@@ -46,39 +43,14 @@ class ExplorerRollout(LookaheadOracle):
 
 def explorer_rollout() -> Contender:
     """``explorer-rollout`` with frontier-rule's weights, in frontier-rule's env."""
-    weights = dict(FRONTIER_RULE_WEIGHTS)
-    return Contender(
-        ExplorerRollout.name,
-        False,
-        lambda: ExplorerRollout(weights),
-        heuristic("frontier-rule").config,
-    )
+    maker = partial(ExplorerRollout, dict(FRONTIER_RULE_WEIGHTS))
+    return Contender(ExplorerRollout.name, False, maker, heuristic("frontier-rule").config)
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--families", default="random-20,random-30,rooms-32")
-    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
-    parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--no-progress", action="store_true")
-    args = parser.parse_args(argv)
-    names = args.families.split(",")
-    try:
-        check_families(names, "--families")
-    except ValueError as exc:
-        parser.error(f"{exc} (valid: {', '.join(FAMILIES)})")
+    parser = study_parser(__doc__, "random-20,random-30,rooms-32")
     policies = [
         *contenders(["nearest-path", "frontier-rule", "lookahead-oracle"]),
         explorer_rollout(),
     ]
-    rows = run_benchmark(
-        [family(name) for name in names],
-        policies,
-        args.episodes,
-        progress=not args.no_progress,
-        split="validation",
-    )
-    print(format_table(rows))
-    if args.json is not None:
-        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
-    return 0
+    return run_study(parser, parser.parse_args(argv), policies)

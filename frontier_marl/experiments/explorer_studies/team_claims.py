@@ -17,18 +17,14 @@ default rule weight is the model's own).
 
 from __future__ import annotations
 
-import argparse
-import json
 from collections.abc import Mapping
 from functools import partial
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from frontier_marl.evaluation.benchmark.families import FAMILIES, check_families, family
-from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic, run_benchmark
-from frontier_marl.evaluation.benchmark.stats import format_table
+from frontier_marl.evaluation.benchmark.run import Contender, contenders, heuristic
+from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.base import Info
 from frontier_marl.policies.map_explorer import MapExplorer
 from frontier_marl.policies.models import map_scorer_folder
@@ -131,33 +127,15 @@ def variant_contender(variant: tuple[float, float, float | None]) -> Contender:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--families", default="random-30,rooms-64")
+    parser = study_parser(__doc__, "random-30,rooms-64")
     parser.add_argument("--agents", type=int, default=4, help="robots per team (2 or more)")
     parser.add_argument("--variants", default="0.3:5,1:5", help="discount:reach[:rule_weight],...")
-    parser.add_argument("--episodes", type=int, default=16, help="validation episodes")
-    parser.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
-    parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    names = args.families.split(",")
     try:
-        check_families(names, "--families")
         variants = [parse_variant(text) for text in args.variants.split(",")]
     except ValueError as exc:
-        parser.error(f"{exc} (families: {', '.join(FAMILIES)})")
+        parser.error(str(exc))
     if args.agents < 2:
         parser.error(f"--agents must be 2 or more, got {args.agents}")
-    rows = run_benchmark(
-        [family(name) for name in names],
-        contenders(BASELINES, "none") + [variant_contender(v) for v in variants],
-        args.episodes,
-        agents=args.agents,
-        progress=not args.no_progress,
-        split="validation",
-        jobs=args.jobs,
-    )
-    print(format_table(rows))
-    if args.json is not None:
-        args.json.write_text(json.dumps({"options": vars(args) | {"json": None}, "rows": rows}))
-    return 0
+    policies = contenders(BASELINES, "none") + [variant_contender(v) for v in variants]
+    return run_study(parser, args, policies, agents=args.agents)
