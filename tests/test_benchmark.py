@@ -422,7 +422,7 @@ def test_the_feature_cost_benchmark_times_every_layout(tmp_path: Path) -> None:
 def test_a_policy_refusing_inside_an_episode_is_one_line_naming_the_episode(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    def refuse(self, observations, infos):
+    def refuse(self: NearestPath, observations: object, infos: object) -> dict[str, int]:
         raise ValueError("this policy cannot act here")
 
     monkeypatch.setattr(NearestPath, "act_team", refuse)

@@ -202,8 +202,13 @@ def test_the_completions_study_plays_its_planner_on_validation_episodes(tmp_path
     rows = json.loads(out.read_text())["rows"]
     assert [row["policy"] for row in rows] == ["frontier-rule", "completions-2"]
     assert all(row["seeds"] == [800_000] and row["success"] == 1 for row in rows)
-    with pytest.raises(SystemExit):
-        completions.main(["--samples", "0"])
+    matched = [*argv, "--match", "2", "--band", "2", "--jobs", "1", "--no-progress"]
+    assert completions.main([*matched, "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert rows[1]["policy"] == "completions-2-of-4-b2" and rows[1]["success"] == 1
+    for bad in (["--samples", "0"], ["--samples", "x"], ["--match", "0"], ["--band", "0"]):
+        with pytest.raises(SystemExit):
+            completions.main(bad)
     planner = completions.CompletionLookahead(2)
     env = frontier_marl.FrontierParallelEnv(preset="thesis-20x20", map_mode="static")
     with pytest.raises(ValueError, match="dynamic generated maps"):

@@ -565,14 +565,15 @@ def test_the_team_claims_study_discounts_targets_near_claimed_ones(tmp_path: Pat
     from frontier_marl.experiments.explorer_studies import team_claims
 
     shipped = MapExplorer.load(map_scorer_folder("explorer"))
-    explorer = team_claims.make_claiming(1.0, 4.0, None)
+    explorer = team_claims.make_claiming((1.0, 4.0, None))
     assert explorer.name == "claims-d1-r4" and explorer.rule_weight == shipped.rule_weight
-    assert team_claims.make_claiming(1.0, 4.0, 2.0).rule_weight == 2.0
+    weighted = team_claims.make_claiming((1.0, 4.0, 2.0))
+    assert weighted.rule_weight == 2.0 and weighted.name == "claims-d1-r4-w2"
     targets = np.array([[0, 0], [0, 10], [4, 4]])
     crowding = explorer._crowding(targets, [np.array([0, 2]), np.array([0, 0])])
     assert crowding.tolist() == pytest.approx([0.5 + 1.0, 0.0, 0.0])
     assert team_claims.parse_variant("0.3:5:2") == (0.3, 5.0, 2.0)
-    for bad in ("1", "a:5", "1:0", "-1:5"):
+    for bad in ("1", "a:5", "1:0", "-1:5", "nan:5", "1:inf"):
         with pytest.raises(ValueError, match="variant"):
             team_claims.parse_variant(bad)
     out = tmp_path / "claims.json"
@@ -581,5 +582,32 @@ def test_the_team_claims_study_discounts_targets_near_claimed_ones(tmp_path: Pat
     rows = json.loads(out.read_text())["rows"]
     assert [row["policy"] for row in rows] == [*team_claims.BASELINES, "claims-d1-r5"]
     assert all(row["seeds"] == [800_000] and row["success"] == 1 for row in rows)
-    with pytest.raises(SystemExit):
-        team_claims.main(["--agents", "1"])
+    for bad in (["--agents", "1"], ["--variants", "1:5,1:5"]):
+        with pytest.raises(SystemExit):
+            team_claims.main(bad)
+
+
+def test_claiming_robots_leave_a_target_a_teammate_took() -> None:
+    from types import SimpleNamespace
+
+    from frontier_marl.experiments.explorer_studies import team_claims
+
+    targets = np.array([[0, 0], [0, 9], [9, 9]])
+    tables = [SimpleNamespace(target=targets, path_length=np.array([1, 2, 3]))] * 3
+    env = SimpleNamespace(
+        possible_agents=["a0", "a1", "a2"], mdp=SimpleNamespace(slot_tables=lambda: tables)
+    )
+    scores = {  # robots 0 and 1 both rate slot 0 best; robot 2 has one valid slot, slot 2
+        0: (np.array([0, 1, 2]), np.array([0.0, 0.5, 0.9])),
+        1: (np.array([0, 1, 2]), np.array([0.0, 0.4, 0.9])),
+        2: (np.array([2]), np.zeros(1)),
+    }
+    observations = {agent: None for agent in env.possible_agents}
+    chosen = {}
+    for discount in (0.0, 10.0):
+        explorer = team_claims.make_claiming((discount, 3.0, None))
+        explorer._env = env
+        explorer.slot_scores = lambda obs, robot: scores[robot]
+        chosen[discount] = explorer.act_team(observations, {})
+    assert chosen[0.0] == {"a0": 0, "a1": 0, "a2": 2}  # no discount: both crowd slot 0
+    assert chosen[10.0] == {"a0": 0, "a1": 1, "a2": 2}  # robot 0 first (lower index on a tie)

@@ -38,7 +38,7 @@ PRETRAINED: dict[str, str] = {
     "explorer": "the learned frontier selector (docs/experiments/2026-12-04-map-aware-"
     "explorer.md): a small CNN over the belief map around each of frontier-rule's 12 slots, "
     "fitted to each candidate's mean cost-to-go over 16 completions of the belief on six "
-    "families by `frontier-marl train explorer` (seed 0, 72-81 minutes, the same weights "
+    "families by `frontier-marl train explorer` (seed 0, 81 minutes, the same weights "
     "every run); it overrules frontier-rule where it predicts a clear gain (the rule's margin "
     "weighed 1); torch only",
     "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): a slot scorer "
