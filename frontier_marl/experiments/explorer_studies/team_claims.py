@@ -31,6 +31,7 @@ from frontier_marl.evaluation.benchmark.run import (
     default_commit,
     heuristic,
 )
+from frontier_marl.evaluation.model_refs import ScorerMaker
 from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.base import Info
 from frontier_marl.policies.map_explorer import MapExplorer
@@ -109,7 +110,7 @@ def make_claiming(variant: Variant) -> ClaimingExplorer:
     folder = map_scorer_folder("explorer")
     if folder is None:
         raise ValueError("the shipped explorer is not a map scorer: this study needs one")
-    explorer = MapExplorer.load(folder)
+    explorer = ScorerMaker(str(folder), "explorer")()  # loaded once per process
     if weight is not None:
         explorer.rule_weight = weight
     return ClaimingExplorer(explorer, discount, reach, variant_name(variant))
