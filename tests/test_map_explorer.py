@@ -119,8 +119,12 @@ def test_grouped_decisions_keep_each_candidates_extra_cells() -> None:
         decision=np.array([1, 1, 0, 0, 0]),
         family=np.full(5, "random-20"),
     )
+    samples.crops[:, 0, 0, 0] = np.arange(5)  # each candidate's crops carry its number
     grouped = group(samples, 4)
     assert grouped.features[..., 0].tolist() == [[2, 3, 4, 0], [0, 1, 0, 0]]
+    assert len(grouped.crops) == 5  # once per candidate, no padding
+    assert (grouped.valid_crops()[:, 0, 0, 0] * 255).tolist() == [2, 3, 4, 0, 1]
+    assert (grouped.subset([1]).valid_crops()[:, 0, 0, 0] * 255).tolist() == [0, 1]
     assert grouped.extra.tolist() == [[0, 5, 30, 0], [4, 0, 0, 0]]
     np.testing.assert_allclose(grouped.regret[0, :3], [0.0, 0.5, 1.0])
 
@@ -143,11 +147,16 @@ def test_the_scorer_is_permutation_equivariant_and_masks_padding() -> None:
     crops = torch.rand(1, 5, *map_crops.crop_shape())
     features = torch.rand(1, 5, 14)
     mask = torch.tensor([[True, True, True, False, False]])
-    scores = model(crops, features, mask)
+    scores = model(crops[mask], features, mask)
     assert torch.isinf(scores[0, 3:]).all() and torch.isfinite(scores[0, :3]).all()
     order = torch.tensor([2, 0, 1, 3, 4])
-    shuffled = model(crops[:, order], features[:, order], mask[:, order])
+    shuffled = model(crops[:, order][mask[:, order]], features[:, order], mask[:, order])
     torch.testing.assert_close(shuffled[0, :3], scores[0, order[:3]])
+    padded = crops.clone()
+    padded[0, 3:] = torch.rand(2, *map_crops.crop_shape())  # the padding's crops are not read
+    torch.testing.assert_close(model(padded[mask], features, mask), scores)
+    with pytest.raises(ValueError, match="5 crops for 3 valid candidates"):
+        model(crops[0], features, mask)
 
 
 @pytest.fixture(scope="module")
@@ -356,7 +365,7 @@ def test_mixed_labels_weigh_the_true_cost_on_the_same_decisions_only() -> None:
 def test_an_average_of_one_scorer_is_that_scorer_and_of_two_their_mean() -> None:
     torch.manual_seed(0)
     first, second = new_scorer(14, 8).eval(), new_scorer(14, 8).eval()
-    crops, features = torch.rand(2, 3, *map_crops.crop_shape()), torch.rand(2, 3, 14)
+    crops, features = torch.rand(5, *map_crops.crop_shape()), torch.rand(2, 3, 14)
     mask = torch.tensor([[True, True, False], [True, True, True]])
     with torch.no_grad():
         one, two = first(crops, features, mask), second(crops, features, mask)
@@ -388,6 +397,9 @@ def test_family_weights_give_every_family_the_same_total() -> None:
     np.testing.assert_allclose(weights.numpy(), [0.5, 0.5, 0.5, 0.5])
     samples.family[2] = "b"  # now "a" has one decision (7), "b" three
     np.testing.assert_allclose(family_weights(samples).numpy(), [1 / 3, 1 / 3, 1.0, 1 / 3])
+    halfway = family_weights(samples, 0.5).numpy()  # totals: "b" sqrt(3), "a" 1
+    np.testing.assert_allclose(halfway, [3**-0.5, 3**-0.5, 1.0, 3**-0.5])
+    np.testing.assert_allclose(family_weights(samples, 0.0).numpy(), [1.0, 1.0, 1.0, 1.0])
 
 
 def test_the_step_size_schedules_have_their_known_values() -> None:
@@ -526,8 +538,16 @@ def test_a_bad_regression_section_is_named() -> None:
         load_experiment("explorer", ["train.families=[]"])
     with pytest.raises(ValueError, match=r"regression.label_every must be an integer >= 1"):
         load_experiment("explorer", ["regression.label_every=0"])
-    with pytest.raises(ValueError, match="regression.balance_families must be true or false"):
-        load_experiment("explorer", ["regression.balance_families=1"])
+    with pytest.raises(ValueError, match="regression.balance_families must be true, false or a"):
+        load_experiment("explorer", ["regression.balance_families=1.5"])
+    with pytest.raises(ValueError, match="regression.completions needs regression.finisher"):
+        load_experiment(
+            "explorer",
+            [
+                "regression.per_family={rooms-32={completions=4}}",
+                'regression.finisher="frontier-rule"',
+            ],
+        )
 
 
 def test_a_family_may_label_its_own_episodes_and_decisions() -> None:
@@ -535,6 +555,9 @@ def test_a_family_may_label_its_own_episodes_and_decisions() -> None:
     reg = cost_regression.RegressionSettings(label_episodes=5, label_every=2, per_family=own)
     assert (reg.label_episodes_of("floorplan-96"), reg.label_every_of("floorplan-96")) == (3, 8)
     assert (reg.label_episodes_of("rooms-32"), reg.label_every_of("rooms-32")) == (5, 2)
+    mixed = {"random-20": {"completions": 16}, "rooms-32": {"completions": 0}}
+    reg = cost_regression.RegressionSettings(completions=4, per_family=mixed)
+    assert [reg.completions_of(f) for f in ("random-20", "rooms-32", "rooms-64")] == [16, 0, 4]
     shipped = cost_regression.RegressionSettings(**load_experiment("explorer").regression)
     assert shipped.label_every_of("floorplan-96") > 1 == shipped.label_every_of("random-20")
 
@@ -546,6 +569,10 @@ def test_a_bad_per_family_entry_is_named() -> None:
         load_experiment("explorer", ["regression.per_family={rooms-32={epochs=2}}"])
     with pytest.raises(ValueError, match=r"per_family.rooms-32.label_every must be an integer"):
         load_experiment("explorer", ["regression.per_family={rooms-32={label_every=0}}"])
+    with pytest.raises(
+        ValueError, match=r"per_family.rooms-32.completions must be an integer >= 0"
+    ):
+        load_experiment("explorer", ["regression.per_family={rooms-32={completions=-1}}"])
     with pytest.raises(ValueError, match=r"regression.per_family.rooms-32 must be a table"):
         load_experiment("explorer", ["regression.per_family={rooms-32=4}"])
 

@@ -125,7 +125,7 @@ class MapExplorer(Policy):
         features = torch.as_tensor(slots[valid], dtype=torch.float32)[None]
         mask = torch.ones((1, len(valid)), dtype=torch.bool)
         with torch.no_grad():
-            regret = self.model(torch.as_tensor(crops)[None], features, mask)[0].numpy()
+            regret = self.model(torch.as_tensor(crops), features, mask)[0].numpy()
         regret = regret.astype(np.float64)
         if self.rule_weight:
             rule = slots[valid].astype(np.float64) @ self._rule

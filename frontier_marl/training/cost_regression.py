@@ -175,7 +175,7 @@ def _label(task: tuple[str, int, dict[str, Any] | None, RegressionSettings, int]
     def behaviour(obs: dict[str, np.ndarray], candidates: Candidates) -> int:
         if model is None or choices.random() < reg.rule_share:
             return int(candidates.slots[int(np.argmax(candidates.features @ rule))])
-        crops = torch.as_tensor(candidates.crops)[None]
+        crops = torch.as_tensor(candidates.crops)
         features = torch.as_tensor(candidates.features)[None]
         with torch.no_grad():
             regret = model(crops, features, torch.ones((1, len(candidates.slots)), dtype=bool))
@@ -183,7 +183,8 @@ def _label(task: tuple[str, int, dict[str, Any] | None, RegressionSettings, int]
 
     base = LinearScorerBase(cfg, weights) if reg.finisher == "frontier-rule" else None
     every = reg.label_every_of(name)
-    return label_episode(cfg, episode, behaviour, base, name, reg.completions, every)
+    completions = reg.completions_of(name)
+    return label_episode(cfg, episode, behaviour, base, name, completions, every)
 
 
 def fitted(
@@ -206,7 +207,7 @@ def fitted(
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))
-    weights = family_weights(samples) if reg.balance_families else None
+    weights = family_weights(samples, reg.balance) if reg.balance else None
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:

@@ -34,11 +34,14 @@ RANKING_TEMPERATURE = 0.05  # a regret 0.05 dearer than another: e times less li
 
 @dataclass
 class Decisions:
-    """Samples grouped by decision: ``crops`` uint8 (D, M, C, S, S), ``features`` float32
-    (D, M, F), ``regret`` float32 (D, M) the fit's target, ``mask`` bool (D, M), ``extra``
-    float32 (D, M) each candidate's cells beyond its decision's cheapest (uncapped)."""
+    """Samples grouped by decision: ``features`` float32 (D, M, F), ``regret`` float32
+    (D, M) the fit's target, ``mask`` bool (D, M), ``extra`` float32 (D, M) each candidate's
+    cells beyond its decision's cheapest (uncapped). The crops are stored once per candidate,
+    unpadded: ``crops`` uint8 (N, C, S, S), and ``rows`` int64 (D, M) the row of each valid
+    candidate's crops (0 on padding)."""
 
     crops: torch.Tensor
+    rows: torch.Tensor
     features: torch.Tensor
     regret: torch.Tensor
     mask: torch.Tensor
@@ -47,15 +50,22 @@ class Decisions:
     def __len__(self) -> int:
         return len(self.mask)
 
-    def subset(self, rows: np.ndarray) -> Decisions:
+    def subset(self, rows: np.ndarray | torch.Tensor) -> Decisions:
+        """The decisions ``rows`` (their crops are shared, not copied)."""
         index = torch.as_tensor(rows)
         return Decisions(
-            self.crops[index],
+            self.crops,
+            self.rows[index],
             self.features[index],
             self.regret[index],
             self.mask[index],
             self.extra[index],
         )
+
+    def valid_crops(self) -> torch.Tensor:
+        """(n, C, S, S) float crops in [0, 1] of the valid candidates, in ``mask`` order: the
+        scorer's input."""
+        return self.crops[self.rows[self.mask]].float() / 255.0
 
 
 def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> Decisions:
@@ -69,11 +79,11 @@ def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> De
     by_decision = np.argsort(order, kind="stable")
     rank[by_decision] = np.arange(len(samples)) - np.repeat(np.cumsum(counts) - counts, counts)
     shape = (len(counts), n_slots)
-    crops = np.zeros((*shape, *samples.crops.shape[1:]), dtype=np.uint8)
+    rows = np.zeros(shape, dtype=np.int64)
     features = np.zeros((*shape, samples.features.shape[1]), dtype=np.float32)
     regret = np.zeros(shape, dtype=np.float32)
     mask = np.zeros(shape, dtype=bool)
-    crops[order, rank] = samples.crops
+    rows[order, rank] = np.arange(len(samples))
     features[order, rank] = samples.features
     regret[order, rank] = (
         relative_regret(samples.cost, order)
@@ -83,16 +93,19 @@ def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> De
     mask[order, rank] = True
     extra = np.zeros(shape, dtype=np.float32)
     extra[order, rank] = cells_regret(samples.cost, order, np.ones(len(samples)), np.inf)
-    return Decisions(*(torch.as_tensor(a) for a in (crops, features, regret, mask, extra)))
+    arrays = (samples.crops, rows, features, regret, mask, extra)
+    return Decisions(*(torch.as_tensor(a) for a in arrays))
 
 
-def family_weights(samples: Samples) -> torch.Tensor:
-    """One weight per decision (in :func:`group`'s order) that gives every family of
-    ``samples`` the same total: one over its family's number of decisions."""
+def family_weights(samples: Samples, balance: float = 1.0) -> torch.Tensor:
+    """One weight per decision (in :func:`group`'s order): its family's number of decisions
+    to the power ``-balance``, so that a family's total grows as its decisions to the power
+    ``1 - balance`` (1: every family of ``samples`` the same total; 0: every decision the
+    same weight)."""
     _, first = np.unique(samples.decision, return_index=True)
     families = samples.family[first]
     _, which, counts = np.unique(families, return_inverse=True, return_counts=True)
-    return torch.as_tensor(1.0 / counts[which], dtype=torch.float64)
+    return torch.as_tensor(counts[which].astype(np.float64) ** -balance, dtype=torch.float64)
 
 
 def symmetry(crops: torch.Tensor, features: torch.Tensor, k: int) -> tuple[torch.Tensor, ...]:
@@ -151,11 +164,11 @@ def fit(
         total, batches = 0.0, 0
         model.train()
         for start in range(0, len(train), batch_size):
-            rows = order[start : start + batch_size]
+            batch = train.subset(order[start : start + batch_size])
             k = int(torch.randint(8, (1,), generator=generator))
-            crops, features = symmetry(train.crops[rows].float() / 255.0, train.features[rows], k)
-            mask = train.mask[rows]
-            value = batch_loss(loss, model(crops, features, mask), train.regret[rows], mask)
+            crops, features = symmetry(batch.valid_crops(), batch.features, k)
+            predicted = model(crops, features, batch.mask)
+            value = batch_loss(loss, predicted, batch.regret, batch.mask)
             optimiser.zero_grad()
             value.backward()
             optimiser.step()
@@ -194,14 +207,10 @@ def batch_loss(
 def predict(model: MapScorer, data: Decisions, batch_size: int = 256) -> torch.Tensor:
     """(D, M) predicted regret (``inf`` on padding)."""
     model.eval()
-    parts = [
-        model(
-            data.crops[start : start + batch_size].float() / 255.0,
-            data.features[start : start + batch_size],
-            data.mask[start : start + batch_size],
-        )
-        for start in range(0, len(data), batch_size)
-    ]
+    parts = []
+    for start in range(0, len(data), batch_size):
+        batch = data.subset(torch.arange(start, min(start + batch_size, len(data))))
+        parts.append(model(batch.valid_crops(), batch.features, batch.mask))
     return torch.cat(parts)
 
 

@@ -242,7 +242,7 @@ FINISHERS = ("nearest-path", "frontier-rule")
 #: The step size over a fit of the map scorer: fixed, or a half cosine down to zero.
 SCHEDULES = ("constant", "cosine")
 #: The labelling settings a family may set for itself (``regression.per_family``).
-PER_FAMILY_KEYS = ("label_episodes", "label_every")
+PER_FAMILY_KEYS = ("label_episodes", "label_every", "completions")
 
 
 @dataclass(frozen=True)
@@ -274,13 +274,15 @@ class RegressionSettings:
         label_every: label one real decision in this many (the first, then every
             ``label_every``-th; the others are played, not labelled): fewer, less correlated
             labels where an episode's decisions are many and their rollouts long.
-        balance_families: draw each gradient step's decisions so that every family weighs
-            the same in the fit, however many decisions it labelled (False: every decision
-            once per epoch).
+        balance_families: how the families weigh in the fit: ``true`` draws each gradient
+            step's decisions so that every family weighs the same, however many decisions it
+            labelled; ``false`` sees every decision once per epoch; a number ``b`` in [0, 1]
+            lies between (a family's total weight grows as its decisions to the power
+            ``1 - b``: 0.5 gives the square root; 1 is ``true``, 0 ``false``).
         fit_schedule: the step size over a fit: ``constant`` (``fit_rate`` throughout) or
             ``cosine`` (from ``fit_rate`` down to zero along a half cosine, so the fit ends
             at rest rather than wherever its last noisy step left it).
-        per_family: a family's own ``label_episodes`` and ``label_every``
+        per_family: a family's own ``label_episodes``, ``label_every`` and ``completions``
             (:data:`PER_FAMILY_KEYS`), for example
             ``{"floorplan-96" = {label_episodes = 24, label_every = 8}}``: few, thinned labels
             where a family's episodes are long; other families take the section's values, and
@@ -299,7 +301,7 @@ class RegressionSettings:
     finisher: str = "nearest-path"
     completions: int = 0
     label_every: int = 1
-    balance_families: bool = False
+    balance_families: bool | float = False
     fit_schedule: str = "constant"
     per_family: dict[str, dict[str, int]] = field(default_factory=dict)
 
@@ -311,11 +313,24 @@ class RegressionSettings:
         """One decision in this many is labelled in ``family``'s episodes."""
         return self.per_family.get(family, {}).get("label_every", self.label_every)
 
+    def completions_of(self, family: str) -> int:
+        """The completions each of ``family``'s labels averages over (0: the true map)."""
+        return self.per_family.get(family, {}).get("completions", self.completions)
+
+    @property
+    def balance(self) -> float:
+        """``balance_families`` as a number in [0, 1] (``true`` is 1, ``false`` 0)."""
+        return float(self.balance_families)
+
     def __post_init__(self) -> None:
         self._check_per_family()
-        if not isinstance(self.balance_families, bool):
+        balance = self.balance_families
+        if not isinstance(balance, bool) and not (
+            isinstance(balance, int | float) and 0 <= balance <= 1
+        ):
             raise ValueError(
-                f"regression.balance_families must be true or false, got {self.balance_families!r}"
+                "regression.balance_families must be true, false or a number in [0, 1], "
+                f"got {balance!r}"
             )
         if self.fit_schedule not in SCHEDULES:
             raise ValueError(
@@ -326,10 +341,9 @@ class RegressionSettings:
             raise ValueError(
                 f"regression.finisher must be one of {', '.join(FINISHERS)}, got {self.finisher!r}"
             )
-        count = self.completions
-        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
-            raise ValueError(f"regression.completions must be an integer >= 0, got {count!r}")
-        if count and self.finisher != "nearest-path":
+        check_int("regression.completions", self.completions, 0)
+        counts = [self.completions, *(v.get("completions", 0) for v in self.per_family.values())]
+        if self.finisher != "nearest-path" and any(counts):
             raise ValueError(
                 "regression.completions needs regression.finisher = 'nearest-path' "
                 f"(the completions are finished by nearest-path), got {self.finisher!r}"
@@ -359,7 +373,7 @@ class RegressionSettings:
         if not isinstance(self.per_family, dict):
             raise ValueError(
                 "regression.per_family must be a table of family name -> {label_episodes, "
-                f"label_every}}, got {self.per_family!r}"
+                f"label_every, completions}}, got {self.per_family!r}"
             )
         from frontier_marl.evaluation.benchmark.families import check_families
 
@@ -374,7 +388,7 @@ class RegressionSettings:
                     f"{where} has unknown keys {unknown}; allowed: {', '.join(PER_FAMILY_KEYS)}"
                 )
             for key, value in values.items():
-                check_int(f"{where}.{key}", value, 1)
+                check_int(f"{where}.{key}", value, 0 if key == "completions" else 1)
 
 
 REGRESSION_KEYS = {f.name for f in dataclasses.fields(RegressionSettings)}

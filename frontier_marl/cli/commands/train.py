@@ -139,6 +139,11 @@ def _worlds(cfg: EnvConfig, settings: TrainSettings) -> tuple[str, str]:
     return world, worlds
 
 
+def _label_source(completions: int) -> str:
+    """What a family's labels average over."""
+    return f"{completions} completions" if completions else "the true map"
+
+
 def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
     """The ``env:`` line and the budget line of the start message."""
     cfg = experiment.env_config()
@@ -156,7 +161,8 @@ def _env_and_budget(experiment: Experiment) -> tuple[str, str]:
         if reg.label_every > 1:
             rollouts = f"{rollouts}; one decision in {reg.label_every} labelled"
         own = "; ".join(
-            f"{name}: {reg.label_episodes_of(name)}, one decision in {reg.label_every_of(name)}"
+            f"{name}: {reg.label_episodes_of(name)}, one decision in {reg.label_every_of(name)}, "
+            + _label_source(reg.completions_of(name))
             for name in reg.per_family
             if name in settings.families  # the others are not labelled
         )

@@ -15,9 +15,12 @@ from torch import nn
 
 
 class MapScorer(nn.Module):
-    """``forward(crops (B, M, C, S, S), features (B, M, F), mask (B, M) bool)`` -> predicted
-    regret (B, M); masked candidates get ``+inf``. ``features`` are normalised inside with
-    the stored ``feature_mean``/``feature_std``."""
+    """``forward(crops (n, C, S, S), features (B, M, F), mask (B, M) bool)`` -> predicted
+    regret (B, M); masked candidates get ``+inf``. ``crops`` are the valid candidates' only,
+    in the order of ``mask``'s true entries (``padded_crops[mask]``; one decision's M
+    candidates, all valid, are simply its (M, C, S, S) crops), so the padding is never
+    convolved. ``features`` are normalised inside with the stored
+    ``feature_mean``/``feature_std``."""
 
     def __init__(self, channels: int, side: int, n_features: int, width: int = 32) -> None:
         super().__init__()
@@ -44,7 +47,10 @@ class MapScorer(nn.Module):
         self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor
     ) -> torch.Tensor:
         batch, count = mask.shape
-        seen = self.conv(crops.reshape(batch * count, *crops.shape[2:])).reshape(batch, count, -1)
+        if len(crops) != int(mask.sum()):
+            raise ValueError(f"{len(crops)} crops for {int(mask.sum())} valid candidates")
+        seen = crops.new_zeros(batch, count, self.conv[-2].out_features)
+        seen[mask] = self.conv(crops)
         scaled = (features - self.feature_mean) / self.feature_std
         embedded = self.embed(torch.cat([seen, scaled], dim=-1))  # (B, M, E)
         weights = mask.unsqueeze(-1).to(embedded.dtype)
