@@ -38,8 +38,8 @@ PRETRAINED: dict[str, str] = {
     "explorer": "the learned frontier selector (docs/experiments/2026-12-04-map-aware-"
     "explorer.md): a small CNN over the belief map around each of frontier-rule's 12 slots, "
     "fitted to each candidate's mean cost-to-go over 16 completions of the belief on six "
-    "families by `frontier-marl train explorer` (seed 0, 81 minutes, the same weights "
-    "every run until its fit became faster); it overrules frontier-rule where it predicts a "
+    "families by `frontier-marl train explorer` (seed 0, the same weights every run; 104 "
+    "minutes here beside another job); it overrules frontier-rule where it predicts a "
     "clear gain (the rule's margin weighed 1); torch only",
     "team-explorer": "the learned team selector (docs/beyond-the-thesis.md): a slot scorer "
     "on frontier-rule's slot features with three teammate features per slot, one "

@@ -1,7 +1,7 @@
 """Fitting the map-aware scorer to the privileged costs (:mod:`~frontier_marl.training.cost_to_go`).
 
-The samples are grouped by decision into padded tensors (at most ``n_slots`` candidates, a
-mask for the rest). The target of each candidate is its relative regret
+The samples are grouped by decision (at most ``n_slots`` candidates, a mask for the rest;
+the crops stored once per candidate, unpadded). The target of each candidate is its relative regret
 (:func:`~frontier_marl.training.cost_to_go.relative_regret`). The shipped fit's loss is the
 mean squared error over the valid candidates (``"regret"`` of :data:`LOSSES`). The ablation
 (:mod:`~frontier_marl.experiments.explorer_studies.map_scorer_ablation`) also fits a listwise
@@ -69,8 +69,9 @@ class Decisions:
 
 
 def group(samples: Samples, n_slots: int, scale: np.ndarray | None = None) -> Decisions:
-    """The decisions of ``samples`` as padded tensors of ``n_slots`` candidates; the target is
-    the relative regret, or with ``scale`` (cells, per sample) the regret in cells over it
+    """The decisions of ``samples``: features, targets and mask padded to ``n_slots``
+    candidates, the crops kept once per candidate (:class:`Decisions`). The target is the
+    relative regret, or with ``scale`` (cells, per sample) the regret in cells over it
     (:func:`~frontier_marl.training.cost_to_go.cells_regret`)."""
     _, order, counts = np.unique(samples.decision, return_inverse=True, return_counts=True)
     if counts.max() > n_slots:
