@@ -55,10 +55,12 @@ from frontier_marl.training.cost_to_go import (  # noqa: E402
 )
 from frontier_marl.training.experiment import load_experiment  # noqa: E402
 from frontier_marl.training.regression import (  # noqa: E402
+    Decisions,
     batch_loss,
     family_weights,
     fit,
     group,
+    members_loss,
     step_size_factor,
     symmetry,
 )
@@ -157,6 +159,61 @@ def test_the_scorer_is_permutation_equivariant_and_masks_padding() -> None:
     torch.testing.assert_close(model(padded[mask], features, mask), scores)
     with pytest.raises(ValueError, match="5 crops for 3 valid candidates"):
         model(crops[0], features, mask)
+
+
+def test_a_scorer_of_several_members_is_the_mean_of_them_run_alone() -> None:
+    """Member k of a batched scorer is a one-member scorer holding its slice of the weights."""
+    torch.manual_seed(1)
+    members, width = 3, 8
+    batched = new_scorer(14, width, members).eval()
+    crops, features = torch.rand(5, *map_crops.crop_shape()), torch.rand(2, 3, 14)
+    mask = torch.tensor([[True, True, False], [True, True, True]])
+    alone = []
+    for k in range(members):
+        single = new_scorer(14, width)
+        state = {}
+        for key, value in batched.state_dict().items():
+            size = len(value) // members
+            state[key] = value if key.startswith("feature_") else value[k * size : (k + 1) * size]
+        single.load_state_dict(state)
+        alone.append(single.eval()(crops, features, mask))
+    with torch.no_grad():
+        each = batched.member_regrets(crops, features, mask)
+        torch.testing.assert_close(each[mask], torch.stack(alone, -1)[mask])
+        torch.testing.assert_close(batched(crops, features, mask), torch.stack(alone).mean(0))
+    with pytest.raises(ValueError, match="members >= 1"):
+        new_scorer(14, width, 0)
+
+
+def test_a_scorer_of_several_members_survives_saving(tmp_path: Path) -> None:
+    torch.manual_seed(2)
+    model = new_scorer(14, 8, members=2).eval()
+    save_map_explorer(model, tmp_path / "scorer", {"rule_weight": 1.0})
+    again, metadata = load_scorer(tmp_path / "scorer")
+    assert metadata["scorer"] == {"n_features": 14, "width": 8, "members": 2}
+    crops, features = torch.rand(3, *map_crops.crop_shape()), torch.rand(1, 3, 14)
+    mask = torch.ones((1, 3), dtype=torch.bool)
+    with torch.no_grad():
+        assert torch.equal(again(crops, features, mask), model(crops, features, mask))
+
+
+def test_each_member_is_fitted_on_its_own_loss() -> None:
+    regret = torch.tensor([[0.0, 0.5, 9.0]])
+    batch = Decisions(
+        torch.zeros((2, 1, 1, 1)),
+        torch.zeros((1, 3), dtype=torch.long),
+        torch.zeros((1, 3, 1)),
+        regret,
+        torch.tensor([[True, True, False]]),
+        torch.zeros((1, 3)),
+    )
+    first = torch.tensor([[0.0, 0.0, float("inf")]])  # loss 0.125
+    second = torch.tensor([[0.0, 0.5, float("inf")]])  # loss 0
+    both = torch.stack([first, second], -1)
+    assert members_loss("regret", both, batch).item() == pytest.approx(0.0625)
+    for kind in ("ranking", "argmax"):
+        alone = [batch_loss(kind, p, regret, batch.mask).item() for p in (first, second)]
+        assert members_loss(kind, both, batch).item() == pytest.approx(np.mean(alone))
 
 
 @pytest.fixture(scope="module")
@@ -421,9 +478,9 @@ def test_a_weighted_fit_draws_only_decisions_of_positive_weight(labelled: Sample
             super().__init__()
             self.bias = torch.nn.Parameter(torch.zeros(1))
 
-        def forward(self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor):
+        def member_regrets(self, crops: torch.Tensor, features: torch.Tensor, mask: torch.Tensor):
             seen.append(features[..., 0].sum(1))
-            return self.bias.expand(mask.shape)
+            return self.bias.expand((*mask.shape, 1))
 
     weights = torch.zeros(len(decisions), dtype=torch.float64)
     weights[3] = 1.0
@@ -538,6 +595,8 @@ def test_a_bad_regression_section_is_named() -> None:
         load_experiment("explorer", ["train.families=[]"])
     with pytest.raises(ValueError, match=r"regression.label_every must be an integer >= 1"):
         load_experiment("explorer", ["regression.label_every=0"])
+    with pytest.raises(ValueError, match=r"regression.scorer_members must be an integer >= 1"):
+        load_experiment("explorer", ["regression.scorer_members=0"])
     with pytest.raises(ValueError, match="regression.balance_families must be true, false or a"):
         load_experiment("explorer", ["regression.balance_families=1.5"])
     with pytest.raises(ValueError, match="regression.completions needs regression.finisher"):

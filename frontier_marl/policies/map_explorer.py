@@ -34,16 +34,20 @@ METADATA_FILE = "model.json"
 MAP_EXPLORER_SETTINGS: dict[str, Any] = dict(FRONTIER_RULE_SETTINGS)
 
 
-def new_scorer(n_features: int, width: int = 32) -> MapScorer:
+def new_scorer(n_features: int, width: int = 32, members: int = 1) -> MapScorer:
     channels, side, _ = crop_shape()
-    return MapScorer(channels, side, n_features, width)
+    return MapScorer(channels, side, n_features, width, members)
 
 
 def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) -> None:
     """``folder/model.pt`` and ``folder/model.json`` (``metadata`` plus the scorer's shape)."""
     folder.mkdir(parents=True, exist_ok=True)
     torch.save(model.state_dict(), folder / MAP_SCORER_FILE)
-    shape = {"n_features": model.feature_mean.numel(), "width": model.conv[0].out_channels}
+    shape = {
+        "n_features": model.feature_mean.numel(),
+        "width": model.width,
+        "members": model.members,
+    }
     record = {"format": MAP_SCORER_FORMAT, "scorer": shape, "env_settings": MAP_EXPLORER_SETTINGS}
     (folder / METADATA_FILE).write_text(json.dumps({**record, **metadata}, indent=2) + "\n")
 
@@ -55,7 +59,8 @@ def load_scorer(folder: str | Path) -> tuple[MapScorer, dict[str, Any]]:
     try:
         metadata = json.loads((folder / METADATA_FILE).read_text())
         shape = metadata["scorer"]
-        model = new_scorer(int(shape["n_features"]), int(shape["width"]))
+        members = int(shape.get("members", 1))  # saved before 2026-12-07: one member
+        model = new_scorer(int(shape["n_features"]), int(shape["width"]), members)
         model.load_state_dict(torch.load(folder / MAP_SCORER_FILE, map_location="cpu"))
     except (OSError, ValueError, KeyError, RuntimeError) as error:
         raise ValueError(f"cannot load the map explorer in {folder}: {error}") from error

@@ -167,7 +167,7 @@ def _label(task: tuple[str, int, dict[str, Any] | None, RegressionSettings, int]
     rule = weights.astype(np.float32)
     model = None
     if state is not None:
-        model = new_scorer(len(rule), reg.scorer_width)
+        model = new_scorer(len(rule), reg.scorer_width, reg.scorer_members)
         model.load_state_dict(state)
         model.eval()
     choices = np.random.default_rng([seed, episode])
@@ -203,7 +203,7 @@ def fitted(
     decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]), scale)
     with torch.random.fork_rng(devices=[]):  # the caller's torch generator is left as it was
         torch.manual_seed(seed)
-        model = new_scorer(decisions.features.shape[-1], reg.scorer_width)
+        model = new_scorer(decisions.features.shape[-1], reg.scorer_width, reg.scorer_members)
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))

@@ -8,7 +8,9 @@ mean squared error over the valid candidates (``"regret"`` of :data:`LOSSES`). T
 ``"ranking"`` loss, ``"argmax"`` imitation of the cheapest candidate, and the regret in cells
 over the map's side. Each batch is seen in one of the eight symmetries of the square (the
 crops rotated or mirrored, the target's row and column offsets turned alike), so the scorer
-learns that a corridor going north is a corridor going east.
+learns that a corridor going north is a corridor going east. A scorer of several members
+(:class:`~frontier_marl.policies.networks.map_scorer.MapScorer`) fits each member on its own
+loss (:func:`members_loss`).
 """
 
 from __future__ import annotations
@@ -168,8 +170,7 @@ def fit(
             batch = train.subset(order[start : start + batch_size])
             k = int(torch.randint(8, (1,), generator=generator))
             crops, features = symmetry(batch.valid_crops(), batch.features, k)
-            predicted = model(crops, features, batch.mask)
-            value = batch_loss(loss, predicted, batch.regret, batch.mask)
+            value = members_loss(loss, model.member_regrets(crops, features, batch.mask), batch)
             optimiser.zero_grad()
             value.backward()
             optimiser.step()
@@ -187,6 +188,15 @@ def step_size_factor(schedule: str, step: int, steps: int) -> float:
     if schedule == "constant":
         return 1.0
     return 0.5 + 0.5 * math.cos(math.pi * min(step, steps) / steps)
+
+
+def members_loss(kind: str, predicted: torch.Tensor, batch: Decisions) -> torch.Tensor:
+    """The mean over the scorer's members of each one's ``kind`` loss on ``batch``, from their
+    predictions (B, M, members): every member is fitted on its own."""
+    batch_size, count, members = predicted.shape
+    folded = predicted.permute(0, 2, 1).reshape(batch_size * members, count)
+    regret = batch.regret.repeat_interleave(members, dim=0)
+    return batch_loss(kind, folded, regret, batch.mask.repeat_interleave(members, dim=0))
 
 
 def batch_loss(

@@ -260,6 +260,8 @@ class RegressionSettings:
         fit_batch: decisions per gradient step.
         fit_rate: Adam's step size.
         scorer_width: the scorer's channels (its embedding is twice this).
+        scorer_members: scorers of that width fitted side by side from their own initial
+            weights, as one batched network, and averaged (1: a single scorer).
         rule_share: the rule's share of the decisions in rounds after the first.
         rule_weights: the weights of frontier-rule's margin tried after each fit
             (:class:`~frontier_marl.policies.map_explorer.MapExplorer`); the best on the
@@ -296,6 +298,7 @@ class RegressionSettings:
     fit_batch: int = 64
     fit_rate: float = 1e-3
     scorer_width: int = 32
+    scorer_members: int = 1
     rule_share: float = 0.5
     rule_weights: tuple[float, ...] = (0.0,)
     finisher: str = "nearest-path"
@@ -360,7 +363,7 @@ class RegressionSettings:
                 f"regression.rule_weights must be a list of numbers >= 0, got {weights!r}"
             )
         counts = ("rounds", "label_episodes", "label_every", "label_workers", "fit_epochs")
-        for name in (*counts, "fit_batch", "scorer_width"):
+        for name in (*counts, "fit_batch", "scorer_width", "scorer_members"):
             check_int(f"regression.{name}", getattr(self, name), 1)
         rate = self.fit_rate
         if isinstance(rate, bool) or not isinstance(rate, int | float) or not rate > 0:

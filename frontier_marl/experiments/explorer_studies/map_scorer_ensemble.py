@@ -12,8 +12,10 @@ at each rule weight of ``--weights`` (k = 1 is one plain fit)::
         --weights 0,0.5,1 --episodes 16 --json ensemble.json
 
 ``--set KEY=VALUE`` changes a fit setting of the run's ``[regression]`` section (e.g.
-``--set scorer_width=64`` for a wider scorer). ``--with RUN`` (repeatable) adds another
-cost-regression run's labels to the fit and its families to the validation. ``--save
+``--set scorer_width=64`` for a wider scorer, ``--set scorer_members=4`` for four scorers
+fitted as one batched network, each fit then itself an average). ``--with RUN``
+(repeatable) adds another cost-regression run's labels to the fit and its families to the
+validation. ``--save
 FOLDER`` keeps the first fit (seed ``seed``) as a map explorer the benchmark plays, with the
 first of ``--weights`` as its rule weight.
 """
