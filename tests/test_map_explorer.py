@@ -32,6 +32,12 @@ from frontier_marl.experiments.explorer_studies.map_scorer_mix import (  # noqa:
     mixed_labels,
 )
 from frontier_marl.experiments.explorer_studies.map_scorer_probe import main as probe_main  # noqa: E402
+from frontier_marl.experiments.explorer_studies.member_spread import (  # noqa: E402
+    SpreadPenalised,
+)
+from frontier_marl.experiments.explorer_studies.member_spread import (  # noqa: E402
+    main as spread_main,
+)
 from frontier_marl.policies import map_crops  # noqa: E402
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS  # noqa: E402
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector  # noqa: E402
@@ -195,6 +201,36 @@ def test_a_scorer_of_several_members_survives_saving(tmp_path: Path) -> None:
     mask = torch.ones((1, 3), dtype=torch.bool)
     with torch.no_grad():
         assert torch.equal(again(crops, features, mask), model(crops, features, mask))
+
+
+def test_the_members_spread_is_added_to_their_mean(tmp_path: Path, capsys) -> None:
+    torch.manual_seed(3)
+    model = new_scorer(14, 8, members=3).eval()
+    crops, features = torch.rand(5, *map_crops.crop_shape()), torch.rand(2, 3, 14)
+    mask = torch.tensor([[True, True, False], [True, True, True]])
+    with torch.no_grad():
+        each = model.member_regrets(crops, features, mask)
+        penalised = SpreadPenalised(model, 2.0)(crops, features, mask)
+        assert torch.equal(
+            SpreadPenalised(model, 0.0)(crops, features, mask), model(crops, features, mask)
+        )
+    torch.testing.assert_close(penalised[mask], (each.mean(-1) + 2 * each.std(-1))[mask])
+    assert torch.isinf(penalised[0, 2])
+    with pytest.raises(ValueError, match="two or more members, the scorer has 1"):
+        SpreadPenalised(new_scorer(14, 8), 1.0)
+    scorer_config_names = feature_names(scorer_config(make_config("thesis-20x20")))
+    save_map_explorer(new_scorer(len(scorer_config_names), 8, 2), tmp_path / "two", {})
+    report = tmp_path / "spread.json"
+    args = ["--spreads", "0,1", "--weights", "1", "--families", "random-20", "--episodes", "1"]
+    assert spread_main([str(tmp_path / "two"), *args, "--json", str(report)]) == 0
+    spreads = json.loads(report.read_text())["spreads"]
+    assert list(spreads) == ["0.0", "1.0"] and set(spreads["1.0"]["1.0"]["by_family"]) == {
+        "random-20"
+    }
+    save_map_explorer(new_scorer(len(scorer_config_names), 8), tmp_path / "one", {})
+    with pytest.raises(SystemExit):
+        spread_main([str(tmp_path / "one"), *args])
+    assert "two or more members" in capsys.readouterr().err
 
 
 def test_each_member_is_fitted_on_its_own_loss() -> None:
