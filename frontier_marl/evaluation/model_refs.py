@@ -80,13 +80,17 @@ class ModelRef:
 class ScorerMaker:
     """A picklable factory of the map scorer saved in ``folder``: a
     :class:`~frontier_marl.policies.map_explorer.MapExplorer` labelled ``label``, with the
-    weight of frontier-rule's margin its training chose (``rule_weight`` in its metadata)."""
+    weight of frontier-rule's margin its training chose (``rule_weight`` in its metadata), or
+    for a team's scorer a :class:`~frontier_marl.policies.team_map_explorer.TeamMapExplorer`."""
 
     folder: str
     label: str
 
     def __call__(self) -> Any:
         from frontier_marl.policies.map_explorer import MapExplorer  # torch: cached_scorer's
+        from frontier_marl.policies.team_map_explorer import TeamMapExplorer
 
         model, metadata = cached_scorer(self.folder)
+        if metadata["scorer"].get("team", False):
+            return TeamMapExplorer(model, self.label)
         return MapExplorer(model, self.label, float(metadata.get("rule_weight", 0.0)))

@@ -41,6 +41,7 @@ __all__ = [
     "LookaheadOracle",
     "NearestPathBase",
     "RolloutBase",
+    "completed_clones",
     "completion_costs",
     "completion_draws",
     "lookahead_costs",
@@ -90,22 +91,32 @@ def completion_costs(
     targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
     m, samples = len(targets), len(maps)
     base = NearestPathBase()
-    sims = branch(source, index, m * samples, base.gain)
+    sims = completed_clones(source, index, m, maps, base.gain)
+    sims.goals[:, 0] = np.tile(targets, (samples, 1))
+    start = int(source.travelled[index, 0])
+    costs = rollout_costs(sims, start, coverage, max_cells, base)
+    return costs.reshape(samples, m).mean(axis=0)
+
+
+def completed_clones(
+    source: Worlds, index: int, count: int, maps: list[np.ndarray], gain: str
+) -> Worlds:
+    """``count`` clones of world ``index`` of ``source`` per map of ``maps`` (map after map),
+    each clone's true map the drawn one with the world's known cells as its belief has them,
+    and its reachable region recomputed from the robots' cells."""
+    sims = branch(source, index, count * len(maps), gain)
     belief = source.belief[index]
     known = belief != UNKNOWN
     for k, drawn in enumerate(maps):
         grid = np.array(drawn, dtype=bool)
         grid[known] = belief[known] == OCCUPIED
         region = reachable_region(grid, source.positions[index])
-        rows = slice(k * m, (k + 1) * m)
+        rows = slice(k * count, (k + 1) * count)
         sims.true[rows] = grid
         sims.start_region[rows] = region
         sims.start_region_size[rows] = np.count_nonzero(region)
         sims.true_free[rows] = np.count_nonzero(~grid)
-    sims.goals[:, 0] = np.tile(targets, (samples, 1))
-    start = int(source.travelled[index, 0])
-    costs = rollout_costs(sims, start, coverage, max_cells, base)
-    return costs.reshape(samples, m).mean(axis=0)
+    return sims
 
 
 def completion_draws(

@@ -34,21 +34,41 @@ METADATA_FILE = "model.json"
 MAP_EXPLORER_SETTINGS: dict[str, Any] = dict(FRONTIER_RULE_SETTINGS)
 
 
-def new_scorer(n_features: int, width: int = 32, members: int = 1) -> MapScorer:
-    channels, side, _ = crop_shape()
+#: The env settings of a team's map scorer: frontier-rule's slots and features with the three
+#: teammate features per slot, every live slot offered each step (the policy keeps targets).
+TEAM_MAP_EXPLORER_SETTINGS: dict[str, Any] = {
+    **MAP_EXPLORER_SETTINGS,
+    "teammates": "positions+targets",
+    "commit": "none",
+}
+
+
+def new_scorer(n_features: int, width: int = 32, members: int = 1, team: bool = False) -> MapScorer:
+    """A fresh scorer of the crops of :func:`~frontier_marl.policies.map_crops.crop_shape`
+    (``team``: with the teammates' channels)."""
+    channels, side, _ = crop_shape(team)
     return MapScorer(channels, side, n_features, width, members)
 
 
+def is_team_scorer(model: MapScorer) -> bool:
+    """Whether ``model`` reads a team's crops (the teammates' channels)."""
+    return model.channels == crop_shape(team=True)[0]
+
+
 def save_map_explorer(model: MapScorer, folder: Path, metadata: dict[str, Any]) -> None:
-    """``folder/model.pt`` and ``folder/model.json`` (``metadata`` plus the scorer's shape)."""
+    """``folder/model.pt`` and ``folder/model.json`` (``metadata`` plus the scorer's shape
+    and the env settings it reads)."""
     folder.mkdir(parents=True, exist_ok=True)
     torch.save(model.state_dict(), folder / MAP_SCORER_FILE)
+    team = is_team_scorer(model)
     shape = {
         "n_features": model.feature_mean.numel(),
         "width": model.width,
         "members": model.members,
+        "team": team,
     }
-    record = {"format": MAP_SCORER_FORMAT, "scorer": shape, "env_settings": MAP_EXPLORER_SETTINGS}
+    settings = TEAM_MAP_EXPLORER_SETTINGS if team else MAP_EXPLORER_SETTINGS
+    record = {"format": MAP_SCORER_FORMAT, "scorer": shape, "env_settings": settings}
     (folder / METADATA_FILE).write_text(json.dumps({**record, **metadata}, indent=2) + "\n")
 
 
@@ -60,7 +80,8 @@ def load_scorer(folder: str | Path) -> tuple[MapScorer, dict[str, Any]]:
         metadata = json.loads((folder / METADATA_FILE).read_text())
         shape = metadata["scorer"]
         members = int(shape.get("members", 1))  # saved before 2026-12-07: one member
-        model = new_scorer(int(shape["n_features"]), int(shape["width"]), members)
+        team = bool(shape.get("team", False))
+        model = new_scorer(int(shape["n_features"]), int(shape["width"]), members, team)
         model.load_state_dict(torch.load(folder / MAP_SCORER_FILE, map_location="cpu"))
     except (OSError, ValueError, KeyError, RuntimeError) as error:
         raise ValueError(f"cannot load the map explorer in {folder}: {error}") from error

@@ -35,6 +35,7 @@ from frontier_marl.evaluation.records import level_key
 from frontier_marl.policies.frontier_rule import FRONTIER_RULE_WEIGHTS
 from frontier_marl.policies.linear_scorer import feature_names, weight_vector
 from frontier_marl.policies.lookahead import LinearScorerBase
+from frontier_marl.policies.map_crops import crop_shape
 from frontier_marl.policies.map_explorer import (
     MAP_EXPLORER_SETTINGS,
     MapExplorer,
@@ -203,7 +204,8 @@ def fitted(
     decisions = group(samples, int(MAP_EXPLORER_SETTINGS["n_slots"]), scale)
     with torch.random.fork_rng(devices=[]):  # the caller's torch generator is left as it was
         torch.manual_seed(seed)
-        model = new_scorer(decisions.features.shape[-1], reg.scorer_width, reg.scorer_members)
+        team = decisions.crops.shape[1] == crop_shape(team=True)[0]  # teammates' channels
+        model = new_scorer(decisions.features.shape[-1], reg.scorer_width, reg.scorer_members, team)
     valid = decisions.features[decisions.mask]
     model.feature_mean.copy_(valid.mean(0))
     model.feature_std.copy_(valid.std(0).clamp(min=1e-3))

@@ -62,8 +62,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--policies",
         default=None,
-        help="comma-separated heuristic names, lookahead-oracle (one robot; it reads the true "
-        "map) and model names or paths (default: "
+        help="comma-separated heuristic names, lookahead-oracle (one robot) or "
+        "team-lookahead-oracle (any team; both read the true map) and model names or paths "
+        "(default: "
         f"{','.join(HEURISTICS)}, plus {','.join(TEAM_HEURISTICS)} with --agents > 1)",
     )
     parser.add_argument(

@@ -1,4 +1,4 @@
-"""The benchmark's policies (:class:`Contender`): heuristics, ``lookahead-oracle`` and models.
+"""The benchmark's policies (:class:`Contender`): heuristics, the oracles and models.
 
 A contender built here is picklable: its factories are module-level functions, partials or
 small dataclasses that name what they load (a model's path, a scorer's folder), so an episode
@@ -29,8 +29,10 @@ from frontier_marl.policies.models import (
     renamed_hint,
 )
 from frontier_marl.policies.registry import POLICIES, env_settings, make_policy
+from frontier_marl.policies.team_lookahead import TeamLookaheadOracle
 
 ORACLE = "lookahead-oracle"
+TEAM_ORACLE = "team-lookahead-oracle"
 
 
 @dataclass
@@ -119,10 +121,15 @@ def model(name: str) -> Contender:
 
 def map_model(folder: Path, label: str) -> Contender:
     """A saved map-aware scorer (:mod:`frontier_marl.policies.map_explorer`): it chooses among
-    frontier-rule's slots, in frontier-rule's env on each world. Needs torch."""
+    frontier-rule's slots, in frontier-rule's env on each world (a team's scorer: in the env
+    settings saved with it). Needs torch."""
     source = str(Path(folder).resolve())
-    cached_scorer(source)
-    return Contender(label, False, ScorerMaker(source, label), heuristic("frontier-rule").config)
+    _, metadata = cached_scorer(source)
+    if metadata["scorer"].get("team", False):
+        config = partial(own_world, metadata["env_settings"])
+    else:
+        config = heuristic("frontier-rule").config
+    return Contender(label, False, ScorerMaker(source, label), config)
 
 
 def oracle() -> Contender:
@@ -131,15 +138,24 @@ def oracle() -> Contender:
     return Contender(LookaheadOracle.name, False, LookaheadOracle, same_world)
 
 
+def team_oracle() -> Contender:
+    """``team-lookahead-oracle`` (:mod:`frontier_marl.policies.team_lookahead`): the lookahead
+    for every robot of a team; like ``lookahead-oracle`` it reads the true map and never counts
+    as the best heuristic."""
+    return Contender(TeamLookaheadOracle.name, False, TeamLookaheadOracle, same_world)
+
+
 def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Contender]:
-    """Heuristics by name, ``lookahead-oracle`` and models by name or path; ValueError for
-    anything else."""
+    """Heuristics by name, the two oracles and models by name or path; ValueError for anything
+    else."""
     out = []
     for name in names:
         if name in POLICIES:
             out.append(heuristic(name, commit))
         elif name == ORACLE:
             out.append(oracle())
+        elif name == TEAM_ORACLE:
+            out.append(team_oracle())
         elif (folder := map_scorer_folder(name)) is not None:
             out.append(map_model(folder, Path(name).name if Path(name).exists() else name))
         elif name in PRETRAINED or Path(name).exists():
@@ -147,6 +163,7 @@ def contenders(names: Sequence[str], commit: str = "until-progress") -> list[Con
         else:
             raise ValueError(
                 f"unknown policy {name!r}: not a heuristic ({', '.join(POLICIES)}), {ORACLE}, "
+                f"{TEAM_ORACLE}, "
                 f"a shipped model ({', '.join(PRETRAINED)}), nor a model file or run folder"
                 + renamed_hint(name)
             )

@@ -39,6 +39,7 @@ from frontier_marl.config import EnvConfig, config_to_dict
 from frontier_marl.envs.parallel import FrontierParallelEnv
 from frontier_marl.evaluation.benchmark.contenders import (
     ORACLE,
+    TEAM_ORACLE,
     Contender,
     contenders,
     default_commit,
@@ -46,6 +47,7 @@ from frontier_marl.evaluation.benchmark.contenders import (
     map_model,
     model,
     oracle,
+    team_oracle,
 )
 from frontier_marl.evaluation.benchmark.families import (
     COVERAGE,
@@ -63,6 +65,7 @@ from frontier_marl.utils.parallel import map_tasks
 
 __all__ = [
     "ORACLE",
+    "TEAM_ORACLE",
     "Contender",
     "EpisodeTask",
     "contenders",
@@ -75,6 +78,7 @@ __all__ = [
     "run_benchmark",
     "run_family",
     "run_on_seeds",
+    "team_oracle",
 ]
 
 

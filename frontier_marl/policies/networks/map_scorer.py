@@ -54,7 +54,7 @@ class MapScorer(nn.Module):
         super().__init__()
         if members < 1 or width < 1:
             raise ValueError(f"a scorer needs width >= 1 and members >= 1, got {width}, {members}")
-        self.width, self.members = width, members
+        self.channels, self.width, self.members = channels, width, members
         reduced = (side + 3) // 4  # after two stride-2 convolutions
         wide = members * width
         self.conv = nn.Sequential(
