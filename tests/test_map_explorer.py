@@ -196,7 +196,7 @@ def test_a_scorer_of_several_members_survives_saving(tmp_path: Path) -> None:
     model = new_scorer(14, 8, members=2).eval()
     save_map_explorer(model, tmp_path / "scorer", {"rule_weight": 1.0})
     again, metadata = load_scorer(tmp_path / "scorer")
-    assert metadata["scorer"] == {"n_features": 14, "width": 8, "members": 2}
+    assert metadata["scorer"] == {"n_features": 14, "width": 8, "members": 2, "team": False}
     crops, features = torch.rand(3, *map_crops.crop_shape()), torch.rand(1, 3, 14)
     mask = torch.ones((1, 3), dtype=torch.bool)
     with torch.no_grad():

@@ -241,30 +241,29 @@ def test_the_decider_counts_the_steps_a_robot_stands_short_of_its_target() -> No
     assert decider._waits.tolist() == [0, 0, 0]
 
 
-def test_team_completion_costs_over_the_true_map_are_the_lookahead_costs() -> None:
-    from frontier_marl.policies.team_lookahead import team_completion_costs
-
+def test_team_costs_over_the_true_map_as_its_completion_are_the_true_maps() -> None:
     env = _env("rooms-32", 3, 4, 3)
     world = env.world
     slots = env.mdp.slot_arrays()
     targets = slots.target[0, : int(slots.live[0])]
     goals = np.full((3, 2), -1, dtype=np.int64)
     base, cap = ClaimingNearestBase(float(env.config.perception_range)), 4 * world.belief.size
-    exact = team_lookahead_costs(world.batch, world.index, 0, targets, goals, 0.99, cap, base)
+
+    def costs(maps: list[np.ndarray] | None) -> np.ndarray:
+        return team_lookahead_costs(
+            world.batch, world.index, 0, targets, goals, 0.99, cap, base, maps=maps
+        )
+
+    exact = costs(None)
     true = world.batch.true[world.index].copy()
-    once = team_completion_costs(
-        world.batch, world.index, 0, targets, goals, 0.99, cap, base, [true]
-    )
-    assert once.tolist() == exact.tolist()
+    assert costs([true]).tolist() == exact.tolist()
     # the mean over maps: the true map twice and a map with every unknown cell an obstacle
     walled = true | (world.belief == UNKNOWN)
-    mixed = team_completion_costs(
-        world.batch, world.index, 0, targets, goals, 0.99, cap, base, [true, walled, true]
-    )
-    alone = team_completion_costs(
-        world.batch, world.index, 0, targets, goals, 0.99, cap, base, [walled]
-    )
-    np.testing.assert_allclose(mixed, (2 * exact + alone) / 3)
+    np.testing.assert_allclose(costs([true, walled, true]), (2 * exact + costs([walled])) / 3)
+    with pytest.raises(ValueError, match="prune"):
+        team_lookahead_costs(
+            world.batch, world.index, 0, targets, goals, 0.99, cap, base, True, [true]
+        )
 
 
 def test_with_one_robot_the_team_oracle_plays_the_single_robot_oracles_episodes() -> None:

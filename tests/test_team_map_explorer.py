@@ -146,7 +146,13 @@ def test_a_team_scorer_is_saved_fitted_and_played_by_the_benchmark(tmp_path: Pat
     bench = ["benchmark", "--agents", "2", "--families", "random-20", "--episodes", "1"]
     assert cli([*bench, "--policies", f"coordinated-assignment,{folder}", "--no-progress"]) == 0
     assert "team-map" in capsys.readouterr().out
-    for bad in (["--agents", "1"], ["--learner", str(tmp_path)], ["--oracle-share", "2"]):
+    bad_options = (
+        ["--agents", "1"],
+        ["--learner", str(tmp_path)],
+        ["--oracle-share", "2"],
+        ["--labels", str(tmp_path / "none.npz")],
+    )
+    for bad in bad_options:
         with pytest.raises(SystemExit):
             main([*argv, *bad, "--save", str(folder)])
 

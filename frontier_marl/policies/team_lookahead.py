@@ -43,41 +43,30 @@ def team_lookahead_costs(
     max_steps: int,
     base: TeamRolloutBase,
     prune: bool = False,
+    maps: list[np.ndarray] | None = None,
 ) -> np.ndarray:
     """Makespan to go of world ``index`` of ``source`` until ``coverage`` is known, per
     candidate target ``targets[m]`` (M, 2) of ``robot``, the other robots first heading for
     ``goals`` (K, 2; row -1: ``base`` decides at once) and ``base`` finishing. A simulation
     that takes ``max_steps`` steps or stalls costs ``max_steps``; ``prune``: only the cheapest
-    candidates' costs are exact (:func:`team_rollout_costs`)."""
-    targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
-    goals = np.asarray(goals, dtype=np.int64).reshape(source.n_agents, 2)
-    sims = branch(source, index, len(targets), base.gain)
-    sims.goals[:] = goals
-    sims.goals[:, robot] = targets
-    return team_rollout_costs(sims, coverage, max_steps, base, prune)
+    candidates' costs are exact (:func:`team_rollout_costs`).
 
-
-def team_completion_costs(
-    source: Worlds,
-    index: int,
-    robot: int,
-    targets: np.ndarray,
-    goals: np.ndarray,
-    coverage: float,
-    max_steps: int,
-    base: TeamRolloutBase,
-    maps: list[np.ndarray],
-) -> np.ndarray:
-    """:func:`team_lookahead_costs` averaged over ``maps`` in place of the true map (each the
-    drawn map where the robots do not know the cells, the belief where they do;
+    With ``maps``, each cost is instead its mean over those maps in place of the true map
+    (each the drawn map where the robots do not know the cells, the belief where they do;
     :func:`~frontier_marl.policies.lookahead.completed_clones`): it reads no true map."""
     targets = np.asarray(targets, dtype=np.int64).reshape(-1, 2)
     goals = np.asarray(goals, dtype=np.int64).reshape(source.n_agents, 2)
-    sims = completed_clones(source, index, len(targets), maps, base.gain)
+    if maps is None:
+        sims = branch(source, index, len(targets), base.gain)
+    elif prune:
+        raise ValueError("pruned costs cannot be averaged over maps: prune=False with maps")
+    else:
+        sims = completed_clones(source, index, len(targets), maps, base.gain)
+    copies = 1 if maps is None else len(maps)
     sims.goals[:] = goals
-    sims.goals[:, robot] = np.tile(targets, (len(maps), 1))
-    costs = team_rollout_costs(sims, coverage, max_steps, base)
-    return costs.reshape(len(maps), len(targets)).mean(axis=0)
+    sims.goals[:, robot] = np.tile(targets, (copies, 1))
+    costs = team_rollout_costs(sims, coverage, max_steps, base, prune)
+    return costs if maps is None else costs.reshape(copies, len(targets)).mean(axis=0)
 
 
 class TeamLookaheadOracle(SequentialTeamDecider):

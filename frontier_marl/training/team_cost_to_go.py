@@ -15,7 +15,7 @@ given a fitted scorer, the scorer's (DAgger: the labelled states are the learner
 
 With ``completions`` K each cost is instead the mean over K maps drawn from the family's
 generator that complete the team's belief
-(:func:`~frontier_marl.policies.team_lookahead.team_completion_costs`): no true map, less
+(``maps`` of :func:`~frontier_marl.policies.team_lookahead.team_lookahead_costs`): no true map, less
 noise, and the "oracle's" choice is then the cheapest under that prior.
 """
 
@@ -33,7 +33,7 @@ from frontier_marl.policies.linear_scorer import explorer_slots
 from frontier_marl.policies.lookahead import completion_draws, require_generated_maps
 from frontier_marl.policies.map_crops import slot_crops
 from frontier_marl.policies.team_decider import SequentialTeamDecider
-from frontier_marl.policies.team_lookahead import team_completion_costs, team_lookahead_costs
+from frontier_marl.policies.team_lookahead import team_lookahead_costs
 from frontier_marl.policies.team_map_explorer import TeamMapExplorer
 from frontier_marl.sim.episodes import EpisodeSource
 from frontier_marl.sim.team_rollouts import ClaimingNearestBase, claimed_nearest_slot
@@ -75,18 +75,15 @@ class _Labeller(SequentialTeamDecider):
         world, config = env.world, env.config
         base = ClaimingNearestBase(config.perception_range)
         cap = 4 * config.height * config.width
-        coverage, targets = config.reward.explore_threshold, table.target[candidates]
+        maps = None
         if self.completions and self.source is not None:
             maps = completion_draws(
                 self.source, world.belief, world.positions, self.completions, self.seed
             )
-            costs = team_completion_costs(
-                world.batch, world.index, robot, targets, goals, coverage, cap, base, maps
-            )
-        else:
-            costs = team_lookahead_costs(
-                world.batch, world.index, robot, targets, goals, coverage, cap, base
-            )
+        costs = team_lookahead_costs(
+            world.batch, world.index, robot, table.target[candidates], goals,
+            config.reward.explore_threshold, cap, base, maps=maps,
+        )  # fmt: skip
         if self.decisions % self.every == 0:
             crops = slot_crops(env, candidates, robot, goals)
             features = explorer_slots(obs)[0][candidates].astype(np.float32)

@@ -114,6 +114,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--completions must be 0 or more, got {args.completions}")
     if not 0.0 <= args.oracle_share <= 1.0:
         parser.error(f"--oracle-share must be in [0, 1], got {args.oracle_share}")
+    missing = [str(path) for path in args.labels if not path.is_file()]
+    if missing:
+        parser.error(f"--labels: no such file {', '.join(missing)}")
     learner = None
     if args.learner is not None:
         folder = map_scorer_folder(args.learner)
