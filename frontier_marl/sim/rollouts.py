@@ -181,19 +181,31 @@ def advance_world(
     no longer a frontier cell or is reached (returns True: it needs a decision). ``state``:
     :meth:`_RolloutState.arrays`; ``world``: :meth:`Worlds.walk_arrays`."""
     done, pending, cost, known, exact, sensed = state
-    belief, travelled, goals = world[3], world[6], world[7]
-    walked, walked_len, reached = world[15], world[16], world[17]
+    (
+        region, region_size, true, belief, seen, positions, travelled, goals, plan_cells,
+        plan_meta, version, cells_per_step, offsets, between, new_cells, walked, walked_len,
+        reached, search,
+    ) = world  # fmt: skip
     moving = pending[n]
     pending[n] = False
     while True:
         if moving:
-            revealed = walk_world(n, world)
+            version[n] = walk(
+                true[n], belief[n], seen[n], positions[n], travelled[n], goals[n],
+                plan_cells[n], plan_meta[n], version[n], cells_per_step, offsets, between,
+                new_cells[n], walked[n], walked_len[n], reached[n], search,
+            )  # fmt: skip
+            revealed = new_cells[n].sum()
             if revealed:
                 known[n] += revealed
                 exact[n] = False
                 _add_sensed(sensed[n], walked[n], walked_len[n])
         moving = True
-        covered = is_covered(n, world, known, exact, coverage)
+        size = max(region_size[n], 1)
+        if not exact[n] and known[n] / size >= coverage:  # the bound says maybe: count
+            known[n] = count_cells(_REACHABLE, belief[n], region[n])
+            exact[n] = True
+        covered = known[n] / size >= coverage
         walked_cells = travelled[n, 0] - start
         if covered or walked_cells >= max_cells:
             done[n] = True
@@ -203,35 +215,6 @@ def advance_world(
         row, col = goals[n, 0, 0], goals[n, 0, 1]
         if row < 0 or not is_frontier(belief[n], row, col) or reached[n, 0]:
             return True
-
-
-@compiled
-def walk_world(n: int, world: tuple) -> int:
-    """One walk of every robot of world ``n`` (``world``: :meth:`Worlds.walk_arrays`); returns
-    the cells it revealed."""
-    (
-        _, _, true, belief, seen, positions, travelled, goals, plan_cells, plan_meta, version,
-        cells_per_step, offsets, between, new_cells, walked, walked_len, reached, search,
-    ) = world  # fmt: skip
-    version[n] = walk(
-        true[n], belief[n], seen[n], positions[n], travelled[n], goals[n], plan_cells[n],
-        plan_meta[n], version[n], cells_per_step, offsets, between, new_cells[n], walked[n],
-        walked_len[n], reached[n], search,
-    )  # fmt: skip
-    return new_cells[n].sum()
-
-
-@compiled
-def is_covered(n: int, world: tuple, known: np.ndarray, exact: np.ndarray, coverage: float) -> bool:
-    """Whether world ``n`` knows ``coverage`` of its reachable region. ``known[n]`` is an
-    upper bound on its known cells of the region (the count itself where ``exact[n]``); the
-    belief is counted only when the bound says the level may be reached."""
-    region, region_size, belief = world[0], world[1], world[3]
-    size = max(region_size[n], 1)
-    if not exact[n] and known[n] / size >= coverage:  # the bound says maybe: count
-        known[n] = count_cells(_REACHABLE, belief[n], region[n])
-        exact[n] = True
-    return known[n] / size >= coverage
 
 
 @compiled
