@@ -223,6 +223,12 @@ def test_the_members_spread_is_added_to_their_mean(tmp_path: Path, capsys) -> No
     report = tmp_path / "spread.json"
     args = ["--spreads", "0,1", "--weights", "1", "--families", "random-20", "--episodes", "1"]
     assert spread_main([str(tmp_path / "two"), *args, "--json", str(report)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert [line.split(":")[0] for line in printed] == [
+        "spread 0.0, rule weight 1.0",
+        "spread 1.0, rule weight 1.0",
+    ]
+    assert all("T99 vs frontier-rule" in line and "(random-20 " in line for line in printed)
     spreads = json.loads(report.read_text())["spreads"]
     assert list(spreads) == ["0.0", "1.0"] and set(spreads["1.0"]["1.0"]["by_family"]) == {
         "random-20"

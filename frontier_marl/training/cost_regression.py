@@ -267,3 +267,15 @@ class Validation:
             "episodes": self.episodes,
             "split": "validation",
         }
+
+    @staticmethod
+    def print_results(prefix: str, results: dict[str, dict[str, Any]]) -> None:
+        """One line per rule weight of ``results`` (this class's results by rule weight),
+        each starting with ``prefix``."""
+        for weight, result in results.items():
+            families = ", ".join(f"{n} {v:+.1%}" for n, v in result["by_family"].items())
+            print(
+                f"{prefix}, rule weight {weight}: T99 vs frontier-rule "
+                f"{result['vs_frontier_rule']:+.1%} ({families})",
+                flush=True,
+            )

@@ -129,13 +129,7 @@ def main(argv: list[str] | None = None) -> int:
         model = Averaged(members[:k]).eval()
         results = {str(w): validation(model, w) for w in weights}
         report["sizes"][str(k)] = results
-        for weight, result in results.items():
-            families = ", ".join(f"{n} {v:+.1%}" for n, v in result["by_family"].items())
-            print(
-                f"{k} scorer(s), rule weight {weight}: T99 vs frontier-rule "
-                f"{result['vs_frontier_rule']:+.1%} ({families})",
-                flush=True,
-            )
+        validation.print_results(f"{k} scorer(s)", results)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2) + "\n")
     return 0

@@ -71,13 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         scorer = SpreadPenalised(model, spread).eval()
         results = {str(w): validation(scorer, w) for w in weights}
         report["spreads"][str(spread)] = results
-        for weight, result in results.items():
-            families = ", ".join(f"{n} {v:+.1%}" for n, v in result["by_family"].items())
-            print(
-                f"spread {spread}, rule weight {weight}: T99 vs frontier-rule "
-                f"{result['vs_frontier_rule']:+.1%} ({families})",
-                flush=True,
-            )
+        validation.print_results(f"spread {spread}", results)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2) + "\n")
     return 0
