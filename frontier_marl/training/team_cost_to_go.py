@@ -11,7 +11,8 @@ sample holds what the robot sees of each candidate (its team crops, with its tea
 channels, and its slot features) and the candidates' costs, as
 :class:`~frontier_marl.training.cost_to_go.Samples`. The behaviour takes the cheapest candidate
 (the team oracle's choice) with probability ``oracle_share``, otherwise the base's choice or,
-given a fitted scorer, the scorer's (DAgger: the labelled states are the learner's own).
+given a ``learner`` (any team decider: a fitted scorer for DAgger), the learner's (the
+labelled states are then the learner's own).
 
 With ``completions`` K each cost is instead the mean over K maps drawn from the family's
 generator that complete the team's belief
@@ -34,7 +35,6 @@ from frontier_marl.policies.lookahead import completion_draws, require_generated
 from frontier_marl.policies.map_crops import slot_crops
 from frontier_marl.policies.team_decider import SequentialTeamDecider
 from frontier_marl.policies.team_lookahead import team_lookahead_costs
-from frontier_marl.policies.team_map_explorer import TeamMapExplorer
 from frontier_marl.sim.episodes import EpisodeSource
 from frontier_marl.sim.team_rollouts import ClaimingNearestBase, claimed_nearest_slot
 from frontier_marl.training.cost_to_go import Samples
@@ -51,7 +51,7 @@ class _Labeller(SequentialTeamDecider):
         oracle_share: float,
         rng: np.random.Generator,
         every: int,
-        learner: TeamMapExplorer | None = None,
+        learner: SequentialTeamDecider | None = None,
         completions: int = 0,
         source: EpisodeSource | None = None,
         seed: int = 0,
@@ -120,7 +120,7 @@ def label_team_episode(
     family: str = "",
     oracle_share: float = 0.5,
     every: int = 1,
-    learner: TeamMapExplorer | None = None,
+    learner: SequentialTeamDecider | None = None,
     completions: int = 0,
 ) -> Samples:
     """Play one team episode of ``cfg`` (reset ``seed``; its env settings those of a team's

@@ -15,7 +15,10 @@ folder that ``frontier-marl benchmark --agents K --policies FOLDER`` plays as a
 The new labels are kept in ``FOLDER/labels.npz``. ``--labels FILE ...`` adds stored labels to
 the fit (``--episodes 0``: fit them alone). A DAgger round labels the learner's own states:
 ``--learner FOLDER`` (a fitted team scorer) takes the decisions the oracle does not, and
-``--round R`` labels the R-th ``--episodes`` of the families' shuffled training seeds::
+``--round R`` labels the R-th ``--episodes`` of the families' shuffled training seeds.
+``--learner team-explorer`` labels the states of the shipped ``team-explorer`` in the team
+protocol instead (:mod:`~frontier_marl.experiments.explorer_studies.team_anchor`), and
+``--every N`` labels every N-th decision only (for costly labels, ``--completions 16``)::
 
     python benchmarks/team_map_scorer.py --episodes 48 --round 1 --learner runs/team-map \
         --labels runs/team-map/labels.npz --save runs/team-map-r1
@@ -34,12 +37,14 @@ import torch
 from frontier_marl.evaluation.benchmark.contenders import own_world
 from frontier_marl.evaluation.benchmark.families import check_families, family, variant_configs
 from frontier_marl.evaluation.model_refs import ScorerMaker
+from frontier_marl.experiments.explorer_studies.team_anchor import ANCHOR, AnchoredTeamExplorer
 from frontier_marl.policies.map_explorer import (
     TEAM_MAP_EXPLORER_SETTINGS,
     load_scorer,
     save_map_explorer,
 )
 from frontier_marl.policies.models import map_scorer_folder
+from frontier_marl.policies.team_decider import SequentialTeamDecider
 from frontier_marl.training.cost_regression import fitted
 from frontier_marl.training.cost_to_go import Samples
 from frontier_marl.training.regression import LOSSES, chosen_regret, group, predict
@@ -49,25 +54,30 @@ from frontier_marl.utils.parallel import map_tasks
 
 PATH_COLUMN = 0  # the ``path`` slot feature: the known-free path length to the target
 
-#: family, reset seed, robots, the oracle's share, the learner's folder (or None), completions
-LabelTask = tuple[str, int, int, float, str | None, int]
+#: family, reset seed, robots, the oracle's share, the learner (a folder, ``team-explorer``
+#: or None), completions, every
+LabelTask = tuple[str, int, int, float, str | None, int, int]
 
 
 def label_task(task: LabelTask) -> Samples:
     """The labels of one team episode of a family's world in the team scorer's env."""
-    name, seed, agents, share, learner, completions = task
+    name, seed, agents, share, learner, completions, every = task
     (world,) = variant_configs(family(name), None, agents)
     cfg = own_world(TEAM_MAP_EXPLORER_SETTINGS, world)
-    policy = None if learner is None else ScorerMaker(learner, "learner")()
-    return label_team_episode(cfg, seed, name, share, learner=policy, completions=completions)
+    policy: SequentialTeamDecider | None = None
+    if learner == ANCHOR:
+        policy = AnchoredTeamExplorer()
+    elif learner is not None:
+        policy = ScorerMaker(learner, "learner")()
+    return label_team_episode(cfg, seed, name, share, every, policy, completions)
 
 
 def label_jobs(
-    names: list[str], episodes: int, round_: int, task: tuple[int, float, str | None, int],
+    names: list[str], episodes: int, round_: int, task: tuple[int, float, str | None, int, int],
     seed: int,
 ) -> list[LabelTask]:  # fmt: skip
     """The ``round_``-th ``episodes`` training seeds per family, shuffled by ``seed``, each
-    with ``task``'s robots, oracle share, learner and completions."""
+    with ``task``'s robots, oracle share, learner, completions and every."""
     rng = np.random.default_rng(seed)
     window = slice(round_ * episodes, (round_ + 1) * episodes)
     return [
@@ -83,11 +93,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--agents", type=int, default=4, help="robots per team (2 or more)")
     parser.add_argument("--episodes", type=int, default=48, help="labelled episodes per family")
     parser.add_argument("--round", type=int, default=0, help="which episodes: the R-th batch")
-    parser.add_argument("--learner", type=Path, default=None, help="a team scorer's folder")
+    parser.add_argument(
+        "--learner", default=None, help=f"a team scorer's folder, or {ANCHOR} (its Q-values)"
+    )
     parser.add_argument("--oracle-share", type=float, default=0.5)
     parser.add_argument(
         "--completions", type=int, default=0, help="K: mean costs over K completions (0: true map)"
     )
+    parser.add_argument("--every", type=int, default=1, help="label every N-th decision")
     parser.add_argument("--workers", type=int, default=2, help="labelling processes")
     parser.add_argument("--epochs", type=int, default=10)
     parser.add_argument("--loss", choices=LOSSES, default="regret", help="the fit's loss")
@@ -117,16 +130,18 @@ def main(argv: list[str] | None = None) -> int:
     missing = [str(path) for path in args.labels if not path.is_file()]
     if missing:
         parser.error(f"--labels: no such file {', '.join(missing)}")
-    learner = None
-    if args.learner is not None:
-        folder = map_scorer_folder(args.learner)
+    if args.every < 1:
+        parser.error(f"--every must be 1 or more, got {args.every}")
+    learner = args.learner
+    if learner is not None and learner != ANCHOR:
+        folder = map_scorer_folder(learner)
         if folder is None or not load_scorer(folder)[1]["scorer"].get("team", False):
-            parser.error(f"--learner {args.learner}: no saved team scorer there")
-        learner = str(args.learner.resolve())
+            parser.error(f"--learner {learner}: no saved team scorer there (nor {ANCHOR})")
+        learner = str(Path(learner).resolve())
     started = time.perf_counter()
     parts = [Samples.load(path) for path in args.labels]
     if args.episodes:
-        task = (args.agents, args.oracle_share, learner, args.completions)
+        task = (args.agents, args.oracle_share, learner, args.completions, args.every)
         jobs = label_jobs(names, args.episodes, args.round, task, args.seed)
         new = Samples.join(
             map_tasks(label_task, jobs, args.workers, progress=not args.no_progress,
