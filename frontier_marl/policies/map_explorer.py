@@ -89,6 +89,15 @@ def load_scorer(folder: str | Path) -> tuple[MapScorer, dict[str, Any]]:
     return model, metadata
 
 
+def team_scorer_folder(name: str | Path) -> Path | None:
+    """The folder of the team scorer saved at (or shipped as) ``name``; None where there is
+    none, or the scorer there is a single robot's."""
+    folder = map_scorer_folder(name)
+    if folder is None or not load_scorer(folder)[1]["scorer"].get("team", False):
+        return None
+    return folder
+
+
 class MapExplorer(Policy):
     """The valid slot of lowest ``predicted regret + rule_weight * rule margin``, where a
     slot's rule margin is how far frontier-rule's score of it falls below the best slot's

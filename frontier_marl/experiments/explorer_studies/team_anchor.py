@@ -34,10 +34,10 @@ from frontier_marl.evaluation.benchmark.contenders import (
     loaded_model,
     own_world,
 )
+from frontier_marl.evaluation.model_refs import cached_scorer
 from frontier_marl.experiments.explorer_studies.validation_study import run_study, study_parser
 from frontier_marl.policies.linear_scorer import explorer_slots, feature_names
-from frontier_marl.policies.map_explorer import TEAM_MAP_EXPLORER_SETTINGS, load_scorer
-from frontier_marl.policies.models import map_scorer_folder
+from frontier_marl.policies.map_explorer import TEAM_MAP_EXPLORER_SETTINGS, team_scorer_folder
 from frontier_marl.policies.team_decider import SequentialTeamDecider
 from frontier_marl.policies.team_map_explorer import TeamMapExplorer
 
@@ -62,7 +62,7 @@ class AnchoredTeamExplorer(SequentialTeamDecider):
         loaded = loaded_model(ANCHOR)
         self.q_network = loaded.model.q_net
         self.anchor_features = feature_names(loaded.env_config())
-        self.scorer = None if scorer is None else TeamMapExplorer(load_scorer(scorer)[0])
+        self.scorer = None if scorer is None else TeamMapExplorer(cached_scorer(scorer)[0])
         self.weight = weight
         self.name = name
         self._columns: list[int] = []
@@ -115,8 +115,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--agents must be 2 or more, got {args.agents}")
     policies = contenders(BASELINES, default_commit(args.agents)) + [anchored(None, 0.0)]
     if args.scorer is not None:
-        folder = map_scorer_folder(args.scorer)
-        if folder is None or not load_scorer(folder)[1]["scorer"].get("team", False):
+        folder = team_scorer_folder(args.scorer)
+        if folder is None:
             parser.error(f"--scorer {args.scorer}: no saved team scorer there")
         try:
             weights = [float(text) for text in args.weights.split(",")]

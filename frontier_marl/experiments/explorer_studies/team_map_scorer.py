@@ -42,6 +42,7 @@ from frontier_marl.policies.map_explorer import (
     TEAM_MAP_EXPLORER_SETTINGS,
     load_scorer,
     save_map_explorer,
+    team_scorer_folder,
 )
 from frontier_marl.policies.models import map_scorer_folder
 from frontier_marl.policies.team_decider import SequentialTeamDecider
@@ -134,8 +135,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--every must be 1 or more, got {args.every}")
     learner = args.learner
     if learner is not None and learner != ANCHOR:
-        folder = map_scorer_folder(learner)
-        if folder is None or not load_scorer(folder)[1]["scorer"].get("team", False):
+        if team_scorer_folder(learner) is None:
             parser.error(f"--learner {learner}: no saved team scorer there (nor {ANCHOR})")
         learner = str(Path(learner).resolve())
     started = time.perf_counter()
